@@ -1,0 +1,232 @@
+//! Buffers: device memory with staging upload and read-back.
+
+use std::sync::Arc;
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::MemoryLocation;
+
+use super::context::{Context, DeviceShared};
+use super::error::{GpuError, GpuResult, VkContext};
+
+/// Where a buffer lives: on the device for passes, or host-visible for transfers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Residency {
+    Device,
+    Upload,
+    Readback,
+}
+
+impl Residency {
+    fn location(self) -> MemoryLocation {
+        match self {
+            Residency::Device => MemoryLocation::GpuOnly,
+            Residency::Upload => MemoryLocation::CpuToGpu,
+            Residency::Readback => MemoryLocation::GpuToCpu,
+        }
+    }
+}
+
+pub struct Buffer {
+    shared: Arc<DeviceShared>,
+    raw: vk::Buffer,
+    allocation: Option<Allocation>,
+    size_bytes: u64,
+    name: String,
+}
+
+pub(crate) fn out_of_memory(what: &str, bytes: u64) -> GpuError {
+    GpuError::OutOfDeviceMemory {
+        what: format!("{what} ({:.1} MiB)", bytes as f64 / (1024.0 * 1024.0)),
+    }
+}
+
+impl Buffer {
+    /// A buffer of `size_bytes` (at least 16: Vulkan has no empty buffers). Device buffers can
+    /// be storage, copy source and copy destination; host buffers are transfer buffers.
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        size_bytes: u64,
+        residency: Residency,
+    ) -> GpuResult<Buffer> {
+        let size_bytes = size_bytes.max(16);
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_SRC
+            | vk::BufferUsageFlags::TRANSFER_DST
+            | vk::BufferUsageFlags::INDIRECT_BUFFER
+            | vk::BufferUsageFlags::VERTEX_BUFFER
+            | vk::BufferUsageFlags::INDEX_BUFFER
+            | vk::BufferUsageFlags::UNIFORM_BUFFER;
+        let shared = ctx.shared.clone();
+        let info = vk::BufferCreateInfo::default()
+            .size(size_bytes)
+            .usage(usage)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        // SAFETY: valid create info on a live device.
+        let raw = unsafe { shared.device.create_buffer(&info, None) }.map_err(|e| match e {
+            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+                out_of_memory(&format!("buffer \"{name}\""), size_bytes)
+            }
+            e => GpuError::Vulkan {
+                call: "vkCreateBuffer",
+                result: e,
+            },
+        })?;
+        // SAFETY: `raw` was just created on this device.
+        let requirements = unsafe { shared.device.get_buffer_memory_requirements(raw) };
+        let allocation = shared.allocator().allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location: residency.location(),
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        });
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: the buffer is unused and unbound.
+                unsafe { shared.device.destroy_buffer(raw, None) };
+                return Err(match e {
+                    gpu_allocator::AllocationError::OutOfMemory => {
+                        out_of_memory(&format!("buffer \"{name}\""), size_bytes)
+                    }
+                    e => GpuError::Unsupported(format!("allocating buffer \"{name}\": {e}")),
+                });
+            }
+        };
+        // SAFETY: memory and buffer come from the same device; the offset is aligned by the
+        // allocator according to the requirements.
+        let bound = unsafe {
+            shared
+                .device
+                .bind_buffer_memory(raw, allocation.memory(), allocation.offset())
+        };
+        let buffer = Buffer {
+            shared,
+            raw,
+            allocation: Some(allocation),
+            size_bytes,
+            name: name.to_string(),
+        };
+        bound.vk("vkBindBufferMemory")?;
+        Ok(buffer)
+    }
+
+    /// A device buffer holding `data`, uploaded through a staging buffer.
+    pub fn from_slice<T: bytemuck::Pod>(
+        ctx: &Context,
+        name: &str,
+        data: &[T],
+    ) -> GpuResult<Buffer> {
+        let buffer = Buffer::new(
+            ctx,
+            name,
+            std::mem::size_of_val(data) as u64,
+            Residency::Device,
+        )?;
+        buffer.upload(ctx, data)?;
+        Ok(buffer)
+    }
+
+    pub fn raw(&self) -> vk::Buffer {
+        self.raw
+    }
+
+    pub fn size_bytes(&self) -> u64 {
+        self.size_bytes
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The mapped bytes of a host-visible buffer.
+    pub fn mapped_bytes_mut(&mut self) -> Option<&mut [u8]> {
+        let size = self.size_bytes as usize;
+        self.allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .map(|s| &mut s[..size])
+    }
+
+    pub fn mapped_bytes(&self) -> Option<&[u8]> {
+        let size = self.size_bytes as usize;
+        self.allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .map(|s| &s[..size])
+    }
+
+    /// Copies `data` to the start of this buffer (via a staging buffer when device-local).
+    pub fn upload<T: bytemuck::Pod>(&self, ctx: &Context, data: &[T]) -> GpuResult<()> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        if bytes.len() as u64 > self.size_bytes {
+            return Err(GpuError::Usage {
+                pass: self.name.clone(),
+                message: format!(
+                    "upload of {} bytes into a buffer of {}",
+                    bytes.len(),
+                    self.size_bytes
+                ),
+            });
+        }
+        if bytes.is_empty() {
+            return Ok(());
+        }
+        let mut staging = Buffer::new(
+            ctx,
+            &format!("{} staging", self.name),
+            bytes.len() as u64,
+            Residency::Upload,
+        )?;
+        staging
+            .mapped_bytes_mut()
+            .expect("upload buffers are host-visible")[..bytes.len()]
+            .copy_from_slice(bytes);
+        ctx.submit(|rec| {
+            rec.copy_buffer(&staging, self, bytes.len() as u64);
+            Ok(())
+        })?;
+        Ok(())
+    }
+
+    /// Reads the whole buffer back as `T`s (via a read-back buffer).
+    pub fn read<T: bytemuck::Pod>(&self, ctx: &Context) -> GpuResult<Vec<T>> {
+        let readback = Buffer::new(
+            ctx,
+            &format!("{} readback", self.name),
+            self.size_bytes,
+            Residency::Readback,
+        )?;
+        ctx.submit(|rec| {
+            rec.copy_buffer(self, &readback, self.size_bytes);
+            Ok(())
+        })?;
+        let bytes = readback
+            .mapped_bytes()
+            .expect("read-back buffers are host-visible");
+        let count = bytes.len() / std::mem::size_of::<T>();
+        // The mapped pointer need not be aligned for T: copy element-wise.
+        Ok(bytemuck::pod_collect_to_vec(
+            &bytes[..count * std::mem::size_of::<T>()],
+        ))
+    }
+}
+
+impl std::fmt::Debug for Buffer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Buffer(\"{}\", {} bytes)", self.name, self.size_bytes)
+    }
+}
+
+impl Drop for Buffer {
+    fn drop(&mut self) {
+        if let Some(allocation) = self.allocation.take() {
+            let _ = self.shared.allocator().free(allocation);
+        }
+        // SAFETY: submissions wait for completion before returning, so the GPU no longer uses
+        // this buffer.
+        unsafe { self.shared.device.destroy_buffer(self.raw, None) };
+    }
+}

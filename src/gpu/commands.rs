@@ -1,0 +1,657 @@
+//! Recording and submitting work: `Context::submit` hands a `Recorder` to a closure, submits
+//! what it recorded, waits, and returns the GPU time of every named pass.
+
+use ash::vk;
+
+use super::buffer::Buffer;
+use super::context::Context;
+use super::error::{GpuError, GpuResult, VkContext};
+use super::image::Image;
+use super::pipeline::{Binding, BindingKind, ComputePipeline};
+
+/// Timestamp pairs per submission; more passes than this in one submission are not timed.
+const MAX_TIMED_PASSES: u32 = 64;
+/// Descriptor sets per pool before the recorder opens another pool.
+const SETS_PER_POOL: u32 = 256;
+
+/// GPU time of each named pass of one submission, in recording order.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Timings {
+    pub passes: Vec<PassTime>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PassTime {
+    pub name: String,
+    pub ms: f64,
+}
+
+impl Timings {
+    pub fn total_ms(&self) -> f64 {
+        self.passes.iter().map(|p| p.ms).sum()
+    }
+
+    /// Sum over passes with this name (a pass may run several times in one submission).
+    pub fn ms(&self, name: &str) -> Option<f64> {
+        let matching: Vec<f64> = self
+            .passes
+            .iter()
+            .filter(|p| p.name == name)
+            .map(|p| p.ms)
+            .collect();
+        (!matching.is_empty()).then(|| matching.iter().sum())
+    }
+
+    pub fn extend(&mut self, other: Timings) {
+        self.passes.extend(other.passes);
+    }
+}
+
+pub struct Recorder<'a> {
+    ctx: &'a Context,
+    cmd: vk::CommandBuffer,
+    descriptor_pools: Vec<vk::DescriptorPool>,
+    sets_left_in_pool: u32,
+    query_pool: Option<vk::QueryPool>,
+    next_query: u32,
+    open_pass: Option<(String, u32)>,
+    passes: Vec<(String, u32)>,
+    /// Buffers that must live until the submission has completed (staging data).
+    keep_alive: Vec<Buffer>,
+}
+
+impl Context {
+    /// Records work with `record`, submits it, waits for it, and returns the pass timings.
+    /// Validation messages produced meanwhile turn into an error.
+    pub fn submit<F>(&self, record: F) -> GpuResult<Timings>
+    where
+        F: FnOnce(&mut Recorder<'_>) -> GpuResult<()>,
+    {
+        let shared = &self.shared;
+        let device = &shared.device;
+        let pool = *shared
+            .command_pool
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
+        // The command pool is externally synchronised: hold its lock while allocating.
+        let cmd = {
+            let _guard = shared
+                .command_pool
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
+            // SAFETY: the pool belongs to this device and is locked.
+            unsafe { device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0]
+        };
+        let query_pool = if shared.timestamp_valid_bits > 0 {
+            let info = vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::TIMESTAMP)
+                .query_count(2 * MAX_TIMED_PASSES);
+            // SAFETY: valid create info on a live device.
+            unsafe { device.create_query_pool(&info, None) }.ok()
+        } else {
+            None
+        };
+        let mut recorder = Recorder {
+            ctx: self,
+            cmd,
+            descriptor_pools: Vec::new(),
+            sets_left_in_pool: 0,
+            query_pool,
+            next_query: 0,
+            open_pass: None,
+            passes: Vec::new(),
+            keep_alive: Vec::new(),
+        };
+        let result = recorder.record_and_run(record);
+        let timings = result.and_then(|()| recorder.read_timings());
+        recorder.release();
+        let _guard = shared
+            .command_pool
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        // SAFETY: the submission has completed (or was never made); the pool is locked.
+        unsafe { device.free_command_buffers(pool, &[cmd]) };
+        let timings = timings?;
+        shared.check_validation()?;
+        Ok(timings)
+    }
+}
+
+impl<'a> Recorder<'a> {
+    fn device(&self) -> &ash::Device {
+        &self.ctx.shared.device
+    }
+
+    fn record_and_run<F>(&mut self, record: F) -> GpuResult<()>
+    where
+        F: FnOnce(&mut Recorder<'_>) -> GpuResult<()>,
+    {
+        let device = self.device().clone();
+        let begin = vk::CommandBufferBeginInfo::default()
+            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: the command buffer is freshly allocated and not in use.
+        unsafe { device.begin_command_buffer(self.cmd, &begin) }.vk("vkBeginCommandBuffer")?;
+        if let Some(pool) = self.query_pool {
+            // SAFETY: recording; the pool has 2·MAX_TIMED_PASSES queries.
+            unsafe { device.cmd_reset_query_pool(self.cmd, pool, 0, 2 * MAX_TIMED_PASSES) };
+        }
+        record(self)?;
+        if self.open_pass.is_some() {
+            self.end_pass();
+        }
+        // SAFETY: recording is complete.
+        unsafe { device.end_command_buffer(self.cmd) }.vk("vkEndCommandBuffer")?;
+        // Catch recording errors (bad bindings, bad barriers) before the driver sees them.
+        self.ctx.shared.check_validation()?;
+        let fence_info = vk::FenceCreateInfo::default();
+        // SAFETY: valid create info; the fence is destroyed below on every path.
+        let fence = unsafe { device.create_fence(&fence_info, None) }.vk("vkCreateFence")?;
+        let cmds = [self.cmd];
+        let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+        let outcome = {
+            let queue = self
+                .ctx
+                .shared
+                .queue
+                .lock()
+                .unwrap_or_else(|e| e.into_inner());
+            // SAFETY: the queue is locked (queues are externally synchronised); the command
+            // buffer is executable.
+            unsafe { device.queue_submit(*queue, &submit, fence) }.vk("vkQueueSubmit")
+        }
+        .and_then(|()| {
+            // SAFETY: the fence belongs to this device.
+            unsafe { device.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")
+        });
+        // SAFETY: the fence is signalled or was never submitted.
+        unsafe { device.destroy_fence(fence, None) };
+        outcome
+    }
+
+    fn read_timings(&mut self) -> GpuResult<Timings> {
+        let Some(pool) = self.query_pool else {
+            return Ok(Timings::default());
+        };
+        if self.next_query == 0 {
+            return Ok(Timings::default());
+        }
+        let mut ticks = vec![0u64; self.next_query as usize];
+        // SAFETY: every query in 0..next_query was written by the completed submission.
+        unsafe {
+            self.device().get_query_pool_results(
+                pool,
+                0,
+                &mut ticks,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .vk("vkGetQueryPoolResults")?;
+        let bits = self.ctx.shared.timestamp_valid_bits;
+        let mask = if bits >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << bits) - 1
+        };
+        let ns_per_tick = f64::from(self.ctx.shared.properties.limits.timestamp_period);
+        let passes = self
+            .passes
+            .iter()
+            .map(|(name, first)| {
+                let start = ticks[*first as usize] & mask;
+                let end = ticks[*first as usize + 1] & mask;
+                PassTime {
+                    name: name.clone(),
+                    ms: end.wrapping_sub(start) as f64 * ns_per_tick * 1e-6,
+                }
+            })
+            .collect();
+        Ok(Timings { passes })
+    }
+
+    fn release(&mut self) {
+        let device = self.device().clone();
+        // SAFETY: the submission has completed; these objects are used by nothing else.
+        unsafe {
+            for pool in self.descriptor_pools.drain(..) {
+                device.destroy_descriptor_pool(pool, None);
+            }
+            if let Some(pool) = self.query_pool.take() {
+                device.destroy_query_pool(pool, None);
+            }
+        }
+        self.keep_alive.clear();
+    }
+
+    pub fn context(&self) -> &Context {
+        self.ctx
+    }
+
+    /// Starts timing a named pass; it ends at `end_pass` or at the next `begin_pass`.
+    pub fn begin_pass(&mut self, name: &str) {
+        if self.open_pass.is_some() {
+            self.end_pass();
+        }
+        let Some(pool) = self.query_pool else { return };
+        if self.next_query + 2 > 2 * MAX_TIMED_PASSES {
+            return;
+        }
+        // SAFETY: recording; the query index is in range and was reset.
+        unsafe {
+            self.device().cmd_write_timestamp(
+                self.cmd,
+                vk::PipelineStageFlags::TOP_OF_PIPE,
+                pool,
+                self.next_query,
+            )
+        };
+        self.open_pass = Some((name.to_string(), self.next_query));
+        self.next_query += 2;
+    }
+
+    pub fn end_pass(&mut self) {
+        let Some((name, first)) = self.open_pass.take() else {
+            return;
+        };
+        let Some(pool) = self.query_pool else { return };
+        // SAFETY: recording; `first + 1` was reserved by begin_pass.
+        unsafe {
+            self.device().cmd_write_timestamp(
+                self.cmd,
+                vk::PipelineStageFlags::BOTTOM_OF_PIPE,
+                pool,
+                first + 1,
+            )
+        };
+        self.passes.push((name, first));
+    }
+
+    /// Makes all earlier shader and transfer writes visible to all later shader and transfer
+    /// reads and writes. Passes are separated by this; finer barriers buy little here.
+    pub fn barrier(&mut self) {
+        let all = vk::AccessFlags::SHADER_READ
+            | vk::AccessFlags::SHADER_WRITE
+            | vk::AccessFlags::TRANSFER_READ
+            | vk::AccessFlags::TRANSFER_WRITE
+            | vk::AccessFlags::INDIRECT_COMMAND_READ
+            | vk::AccessFlags::HOST_READ
+            | vk::AccessFlags::COLOR_ATTACHMENT_WRITE
+            | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+        let barrier = [vk::MemoryBarrier::default()
+            .src_access_mask(all)
+            .dst_access_mask(all)];
+        // SAFETY: recording; a global memory barrier has no resource references.
+        unsafe {
+            self.device().cmd_pipeline_barrier(
+                self.cmd,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::DependencyFlags::empty(),
+                &barrier,
+                &[],
+                &[],
+            )
+        };
+    }
+
+    pub(crate) fn transition_to_general(&mut self, image: &Image) {
+        let barrier = [vk::ImageMemoryBarrier::default()
+            .old_layout(vk::ImageLayout::UNDEFINED)
+            .new_layout(vk::ImageLayout::GENERAL)
+            .src_access_mask(vk::AccessFlags::empty())
+            .dst_access_mask(vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image.raw())
+            .subresource_range(image.subresource_range())];
+        // SAFETY: recording; the image belongs to this device.
+        unsafe {
+            self.device().cmd_pipeline_barrier(
+                self.cmd,
+                vk::PipelineStageFlags::TOP_OF_PIPE,
+                vk::PipelineStageFlags::ALL_COMMANDS,
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &barrier,
+            )
+        };
+    }
+
+    pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size_bytes: u64) {
+        let region = [vk::BufferCopy {
+            src_offset: 0,
+            dst_offset: 0,
+            size: size_bytes,
+        }];
+        // SAFETY: recording; sizes are within both buffers (callers check).
+        unsafe {
+            self.device()
+                .cmd_copy_buffer(self.cmd, src.raw(), dst.raw(), &region)
+        };
+        self.barrier();
+    }
+
+    /// Fills the whole buffer with a repeated 32-bit value.
+    pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
+        // SAFETY: recording; WHOLE_SIZE covers the buffer, whose size is a multiple of 4.
+        unsafe {
+            self.device()
+                .cmd_fill_buffer(self.cmd, buffer.raw(), 0, vk::WHOLE_SIZE, value)
+        };
+        self.barrier();
+    }
+
+    /// Uploads `data` into `dst` within this submission (the staging buffer lives until the
+    /// submission completes).
+    pub fn upload_buffer<T: bytemuck::Pod>(&mut self, dst: &Buffer, data: &[T]) -> GpuResult<()> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        if bytes.is_empty() {
+            return Ok(());
+        }
+        if bytes.len() as u64 > dst.size_bytes() {
+            return Err(GpuError::Usage {
+                pass: dst.name().to_string(),
+                message: format!(
+                    "upload of {} bytes into a buffer of {}",
+                    bytes.len(),
+                    dst.size_bytes()
+                ),
+            });
+        }
+        let mut staging = Buffer::new(
+            self.ctx,
+            &format!("{} staging", dst.name()),
+            bytes.len() as u64,
+            super::Residency::Upload,
+        )?;
+        staging
+            .mapped_bytes_mut()
+            .expect("upload buffers are host-visible")[..bytes.len()]
+            .copy_from_slice(bytes);
+        self.copy_buffer(&staging, dst, bytes.len() as u64);
+        self.keep_alive.push(staging);
+        Ok(())
+    }
+
+    pub(crate) fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(dst.subresource_layers())
+            .image_extent(dst.vk_extent())];
+        // SAFETY: recording; the image is in GENERAL layout and the buffer holds every texel.
+        unsafe {
+            self.device().cmd_copy_buffer_to_image(
+                self.cmd,
+                src.raw(),
+                dst.raw(),
+                vk::ImageLayout::GENERAL,
+                &region,
+            )
+        };
+        self.barrier();
+    }
+
+    pub(crate) fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+        let region = [vk::BufferImageCopy::default()
+            .image_subresource(src.subresource_layers())
+            .image_extent(src.vk_extent())];
+        // SAFETY: recording; the image is in GENERAL layout and the buffer fits every texel.
+        unsafe {
+            self.device().cmd_copy_image_to_buffer(
+                self.cmd,
+                src.raw(),
+                vk::ImageLayout::GENERAL,
+                dst.raw(),
+                &region,
+            )
+        };
+        self.barrier();
+    }
+
+    /// Clears a colour image to `rgba`.
+    pub fn clear_image(&mut self, image: &Image, rgba: [f32; 4]) {
+        let color = vk::ClearColorValue { float32: rgba };
+        // SAFETY: recording; the image is in GENERAL layout.
+        unsafe {
+            self.device().cmd_clear_color_image(
+                self.cmd,
+                image.raw(),
+                vk::ImageLayout::GENERAL,
+                &color,
+                &[image.subresource_range()],
+            )
+        };
+        self.barrier();
+    }
+
+    fn allocate_set(&mut self, pipeline: &ComputePipeline) -> GpuResult<vk::DescriptorSet> {
+        if self.sets_left_in_pool == 0 {
+            let sizes = [
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::STORAGE_BUFFER,
+                    descriptor_count: SETS_PER_POOL * 8,
+                },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::UNIFORM_BUFFER,
+                    descriptor_count: SETS_PER_POOL * 2,
+                },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                    descriptor_count: SETS_PER_POOL * 4,
+                },
+                vk::DescriptorPoolSize {
+                    ty: vk::DescriptorType::STORAGE_IMAGE,
+                    descriptor_count: SETS_PER_POOL * 4,
+                },
+            ];
+            let info = vk::DescriptorPoolCreateInfo::default()
+                .max_sets(SETS_PER_POOL)
+                .pool_sizes(&sizes);
+            // SAFETY: valid create info; destroyed in release().
+            let pool = unsafe { self.device().create_descriptor_pool(&info, None) }
+                .vk("vkCreateDescriptorPool")?;
+            self.descriptor_pools.push(pool);
+            self.sets_left_in_pool = SETS_PER_POOL;
+        }
+        let layouts = [pipeline.set_layout];
+        let info = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(*self.descriptor_pools.last().expect("pool just ensured"))
+            .set_layouts(&layouts);
+        // SAFETY: the pool has room (at most 8 storage buffers per set are assumed; a pass with
+        // more bindings of one kind would fail here with a Vulkan error, not UB).
+        let set = unsafe { self.device().allocate_descriptor_sets(&info) }
+            .vk("vkAllocateDescriptorSets")?[0];
+        self.sets_left_in_pool -= 1;
+        Ok(set)
+    }
+
+    /// Binds `bindings` (in the pipeline's declared order) and `push_constants`, and
+    /// dispatches `groups` workgroups. A barrier follows, so the next pass sees the results.
+    pub fn dispatch<P: bytemuck::Pod>(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[Binding<'_>],
+        push_constants: &P,
+        groups: [u32; 3],
+    ) -> GpuResult<()> {
+        self.bind(pipeline, bindings, bytemuck::bytes_of(push_constants))?;
+        let max = self.ctx.limits().max_compute_work_group_count;
+        if groups.iter().zip(max.iter()).any(|(g, m)| g > m) {
+            return Err(GpuError::Usage {
+                pass: pipeline.name.clone(),
+                message: format!(
+                    "dispatch of {groups:?} workgroups exceeds the device limit {max:?}"
+                ),
+            });
+        }
+        if groups.contains(&0) {
+            return Ok(());
+        }
+        // SAFETY: recording; pipeline, set and push constants were bound by bind().
+        unsafe {
+            self.device()
+                .cmd_dispatch(self.cmd, groups[0], groups[1], groups[2])
+        };
+        self.barrier();
+        Ok(())
+    }
+
+    /// As `dispatch`, with the workgroup counts read from `args` (three u32 at `offset`).
+    pub fn dispatch_indirect<P: bytemuck::Pod>(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[Binding<'_>],
+        push_constants: &P,
+        args: &Buffer,
+        offset: u64,
+    ) -> GpuResult<()> {
+        self.bind(pipeline, bindings, bytemuck::bytes_of(push_constants))?;
+        // SAFETY: recording; the args buffer has INDIRECT usage and holds 12 bytes at offset.
+        unsafe {
+            self.device()
+                .cmd_dispatch_indirect(self.cmd, args.raw(), offset)
+        };
+        self.barrier();
+        Ok(())
+    }
+
+    fn bind(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[Binding<'_>],
+        push: &[u8],
+    ) -> GpuResult<()> {
+        let usage = |message: String| GpuError::Usage {
+            pass: pipeline.name.clone(),
+            message,
+        };
+        if bindings.len() != pipeline.kinds.len() {
+            return Err(usage(format!(
+                "{} bindings given, the pipeline declares {}",
+                bindings.len(),
+                pipeline.kinds.len()
+            )));
+        }
+        if push.len() as u32 != pipeline.push_constant_bytes {
+            return Err(usage(format!(
+                "{} bytes of push constants given, the pipeline declares {}",
+                push.len(),
+                pipeline.push_constant_bytes
+            )));
+        }
+        for (i, (binding, kind)) in bindings.iter().zip(&pipeline.kinds).enumerate() {
+            if !binding.matches(*kind) {
+                return Err(usage(format!("binding {i} must be a {kind:?}")));
+            }
+        }
+        let max_range = u64::from(self.ctx.limits().max_storage_buffer_range);
+        let set = self.allocate_set(pipeline)?;
+        let mut buffer_infos = Vec::with_capacity(bindings.len());
+        let mut image_infos = Vec::with_capacity(bindings.len());
+        for (i, binding) in bindings.iter().enumerate() {
+            match *binding {
+                Binding::Buffer(b) => {
+                    if pipeline.kinds[i] == BindingKind::StorageBuffer && b.size_bytes() > max_range
+                    {
+                        return Err(usage(format!(
+                            "buffer \"{}\" of {} MiB exceeds this device's {} MiB storage-buffer binding limit; bind it in ranges",
+                            b.name(),
+                            b.size_bytes() >> 20,
+                            max_range >> 20
+                        )));
+                    }
+                    buffer_infos.push((
+                        i,
+                        vk::DescriptorBufferInfo {
+                            buffer: b.raw(),
+                            offset: 0,
+                            range: vk::WHOLE_SIZE,
+                        },
+                    ));
+                }
+                Binding::BufferRange(b, offset, size) => {
+                    if offset + size > b.size_bytes() || size > max_range {
+                        return Err(usage(format!("range {offset}+{size} of buffer \"{}\" is out of bounds or over the binding limit", b.name())));
+                    }
+                    buffer_infos.push((
+                        i,
+                        vk::DescriptorBufferInfo {
+                            buffer: b.raw(),
+                            offset,
+                            range: size,
+                        },
+                    ));
+                }
+                Binding::Sampled(image, sampler) => image_infos.push((
+                    i,
+                    vk::DescriptorImageInfo {
+                        sampler: sampler.raw(),
+                        image_view: image.view(),
+                        image_layout: vk::ImageLayout::GENERAL,
+                    },
+                )),
+                Binding::Storage(image) => image_infos.push((
+                    i,
+                    vk::DescriptorImageInfo {
+                        sampler: vk::Sampler::null(),
+                        image_view: image.view(),
+                        image_layout: vk::ImageLayout::GENERAL,
+                    },
+                )),
+            }
+        }
+        let mut writes = Vec::with_capacity(bindings.len());
+        for (i, info) in &buffer_infos {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(*i as u32)
+                    .descriptor_type(pipeline.kinds[*i].descriptor_type())
+                    .buffer_info(std::slice::from_ref(info)),
+            );
+        }
+        for (i, info) in &image_infos {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(*i as u32)
+                    .descriptor_type(pipeline.kinds[*i].descriptor_type())
+                    .image_info(std::slice::from_ref(info)),
+            );
+        }
+        let device = self.device();
+        // SAFETY: the set is freshly allocated for this layout; infos outlive the call; the
+        // command buffer is recording.
+        unsafe {
+            device.update_descriptor_sets(&writes, &[]);
+            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
+            device.cmd_bind_descriptor_sets(
+                self.cmd,
+                vk::PipelineBindPoint::COMPUTE,
+                pipeline.layout,
+                0,
+                &[set],
+                &[],
+            );
+            if !push.is_empty() {
+                device.cmd_push_constants(
+                    self.cmd,
+                    pipeline.layout,
+                    vk::ShaderStageFlags::COMPUTE,
+                    0,
+                    push,
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The raw command buffer, for passes (such as the rasteriser) that record graphics work
+    /// this layer does not wrap.
+    pub fn raw_command_buffer(&self) -> vk::CommandBuffer {
+        self.cmd
+    }
+}

@@ -1,0 +1,23 @@
+//! A thin, safe RAII layer over ash and gpu-allocator. It knows nothing about eyes: passes in
+//! `render` build on it. Every resource holds the device alive; every submission waits for
+//! completion, so resources can be dropped in any order.
+
+mod buffer;
+mod commands;
+mod context;
+mod error;
+mod image;
+mod pipeline;
+pub mod texture_probe;
+
+pub use buffer::{Buffer, Residency};
+pub use commands::{PassTime, Recorder, Timings};
+pub use context::{
+    list_devices, resolve_device, Context, ContextOptions, DeviceInfo, DeviceKind, Validation,
+    ValidationLog,
+};
+pub use error::{GpuError, GpuResult};
+pub use image::{Edge, Image, ImageUsage, Sampler, TexelFormat};
+pub use pipeline::{Binding, BindingKind, ComputePipeline, ComputePipelineBuilder};
+
+pub use ash::vk;

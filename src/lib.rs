@@ -1,0 +1,16 @@
+//! ocular: renders a 3D scene as a particular human eye sees it.
+//!
+//! The map of the crate is in DESIGN.md: `optics`, `eye` and `psf` are pure numerics; `gpu` is
+//! a thin Vulkan layer that knows nothing about eyes; `render` joins them; `cli` holds one file
+//! per subcommand.
+
+pub mod cli;
+pub mod error;
+pub mod gpu;
+
+/// SPIR-V of every shader under `glsl/`, compiled by build.rs.
+pub mod shaders {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+}
+
+pub use error::{Error, Result};
