@@ -7,6 +7,8 @@
 pub mod cli;
 pub mod error;
 pub mod gpu;
+pub mod psf;
+pub mod render;
 
 /// SPIR-V of every shader under `glsl/`, compiled by build.rs.
 pub mod shaders {

@@ -194,6 +194,7 @@ pub(crate) struct DeviceShared {
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) properties: vk::PhysicalDeviceProperties,
     pub(crate) timestamp_valid_bits: u32,
+    pub(crate) features: vk::PhysicalDeviceFeatures,
     pub(crate) validation_log: Arc<ValidationLog>,
     pub(crate) validating: bool,
     pub(crate) info: DeviceInfo,
@@ -505,7 +506,20 @@ impl Context {
         let queue_info = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(queue_family)
             .queue_priorities(&priorities)];
-        let info_create = vk::DeviceCreateInfo::default().queue_create_infos(&queue_info);
+        // Passes write 3D images whose format is chosen at run time (RGBA16F or RGBA32F), so
+        // storage images without a format qualifier are needed where the device has them.
+        // SAFETY: `physical` belongs to `instance`.
+        let available = unsafe { instance.get_physical_device_features(physical) };
+        let features = vk::PhysicalDeviceFeatures::default()
+            .shader_storage_image_write_without_format(
+                available.shader_storage_image_write_without_format == vk::TRUE,
+            )
+            .shader_storage_image_read_without_format(
+                available.shader_storage_image_read_without_format == vk::TRUE,
+            );
+        let info_create = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&queue_info)
+            .enabled_features(&features);
         // SAFETY: pointers in the create info outlive the call.
         let device =
             unsafe { instance.create_device(physical, &info_create, None) }.vk("vkCreateDevice")?;
@@ -566,6 +580,7 @@ impl Context {
                 allocator: ManuallyDrop::new(Mutex::new(allocator)),
                 properties,
                 timestamp_valid_bits: families[queue_family as usize].timestamp_valid_bits,
+                features,
                 validation_log: log,
                 validating: validate,
                 info,
@@ -595,6 +610,14 @@ impl Context {
     /// Fails with the messages the validation layer produced since the last check.
     pub fn check_validation(&self) -> GpuResult<()> {
         self.shared.check_validation()
+    }
+
+    /// Whether shaders may write storage images declared without a format qualifier.
+    pub fn can_write_images_without_format(&self) -> bool {
+        self.shared
+            .features
+            .shader_storage_image_write_without_format
+            == vk::TRUE
     }
 
     /// The queue family all work is submitted to (graphics and compute).

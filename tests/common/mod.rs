@@ -30,3 +30,6 @@ pub fn finish(ctx: Context) {
         eprintln!("note: the Vulkan validation layer is not installed; validation was not checked");
     }
 }
+
+pub mod splat_cpu;
+pub mod synthetic;

@@ -1,0 +1,73 @@
+// Declarations shared by the tiled PSF-splatting passes (src/render/splat/).
+#ifndef OCULAR_SPLAT_GLSL
+#define OCULAR_SPLAT_GLSL
+
+// One screen-space fragment: a pixel, or a merged block of size × size pixels.
+// Mirrors `Fragment` in src/render/splat/mod.rs (std430, 48 bytes).
+struct Fragment {
+    vec3 color;    // linear RGB
+    float depth;   // metres along the view axis: the sort key
+    vec3 radius;   // blur radius in pixels per channel (R, G, B), clamped to Rmax
+    float index;   // continuous index on the object-dioptre axis of the PSF texture
+    vec2 center;   // footprint centre in pixels (a pixel's centre is x + 0.5)
+    uint size;     // 1 = single pixel, 2 or 4 = merged block; 0 = merged away
+    uint pad;
+};
+
+// Per-frame constants, identical for every pass. Mirrors `FrameParams` in mod.rs.
+layout(push_constant) uniform FrameParams {
+    uint width;
+    uint height;
+    uint tiles_x;
+    uint tiles_y;
+    uint tile_size;
+    uint object_count;     // No
+    uint max_radius;       // Rmax
+    uint fragment_count;   // width * height
+    float dioptre_min;
+    float dioptre_step;
+    float merge_min_radius;
+    float merge_color_tolerance;
+    float merge_dioptre_tolerance;
+    uint band_first_tile;  // tiles [band_first_tile, band_end_tile) are processed this band
+    uint band_end_tile;
+    uint band_first_entry; // global list offset of the band's first entry
+    uvec4 pass_u;          // pass-specific values (see each pass)
+    vec4 pass_f;
+} frame;
+
+// How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.
+// Kernels of radius r occupy (2r+1)² texels centred on the fragment; a merged fragment sits
+// half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further.
+float fragment_reach(Fragment f) {
+    float r = ceil(max(f.radius.r, max(f.radius.g, f.radius.b)));
+    return f.size > 1u ? r + 0.5 : r;
+}
+
+// Inclusive tile rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of
+// the fragment's centre on both axes. Exact for the square kernel support; empty if off screen.
+ivec4 fragment_tiles(Fragment f) {
+    float reach = fragment_reach(f);
+    // Pixel px has centre px + 0.5; it is covered when |px + 0.5 - c| <= reach.
+    ivec2 p0 = ivec2(ceil(f.center - 0.5 - reach));
+    ivec2 p1 = ivec2(floor(f.center - 0.5 + reach));
+    p0 = max(p0, ivec2(0));
+    p1 = min(p1, ivec2(int(frame.width) - 1, int(frame.height) - 1));
+    if (p0.x > p1.x || p0.y > p1.y) {
+        return ivec4(0, 0, -1, -1);
+    }
+    int t = int(frame.tile_size);
+    return ivec4(p0 / t, p1 / t);
+}
+
+// Sort key of a list entry: depth bits (positive floats order like their bit patterns), then
+// the fragment index, so that equal depths sort deterministically.
+uvec2 entry_key(float depth, uint fragment) {
+    return uvec2(floatBitsToUint(max(depth, 0.0)), fragment);
+}
+
+bool key_less(uvec2 a, uvec2 b) {
+    return a.x < b.x || (a.x == b.x && a.y < b.y);
+}
+
+#endif

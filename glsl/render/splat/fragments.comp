@@ -1,0 +1,39 @@
+#version 460
+// One fragment per pixel: colour, depth, continuous index on the object-dioptre axis and the
+// blur radius per channel, interpolated between the two neighbouring object distances.
+#extension GL_GOOGLE_include_directive : require
+#include "splat.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 0, rgba32f) readonly uniform image2D color_in;
+layout(binding = 1, r32f) readonly uniform image2D depth_in;
+// Natural radius per object distance, per channel (xyz), of this frame's blended kernels.
+layout(std430, binding = 2) readonly buffer Radii { vec4 radii[]; };
+layout(std430, binding = 3) writeonly buffer Fragments { Fragment fragments[]; };
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= frame.width || p.y >= frame.height) {
+        return;
+    }
+    vec3 color = imageLoad(color_in, ivec2(p)).rgb;
+    float depth = imageLoad(depth_in, ivec2(p)).r;
+    // Infinite, missing or non-positive depth is optical infinity (0 D).
+    float dioptre = (depth > 0.0 && !isinf(depth) && !isnan(depth)) ? 1.0 / depth : 0.0;
+    float last = float(frame.object_count - 1u);
+    float index = clamp((dioptre - frame.dioptre_min) / frame.dioptre_step, 0.0, last);
+    uint i0 = uint(floor(index));
+    uint i1 = min(i0 + 1u, frame.object_count - 1u);
+    vec3 radius = mix(radii[i0].xyz, radii[i1].xyz, index - float(i0));
+
+    Fragment f;
+    f.color = color;
+    f.depth = (depth > 0.0 && !isnan(depth)) ? depth : 3.0e38;
+    f.radius = min(radius, vec3(float(frame.max_radius)));
+    f.index = index;
+    f.center = vec2(p) + 0.5;
+    f.size = 1u;
+    f.pad = 0u;
+    fragments[p.y * frame.width + p.x] = f;
+}

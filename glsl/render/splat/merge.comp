@@ -1,0 +1,75 @@
+#version 460
+// Merges blocks of similar, strongly blurred fragments into one fragment, in place: the
+// merged fragment takes the block's top-left slot, the others are marked merged away (size 0).
+// pass_u.x is the block size this dispatch makes: 2 merges 2×2 single pixels, 4 merges 2×2
+// already-merged 2×2 blocks. Thresholds scale with the block's smallest blur radius: the more
+// blur, the less a small difference in colour or dioptre can show.
+#extension GL_GOOGLE_include_directive : require
+#include "splat.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std430, binding = 0) buffer Fragments { Fragment fragments[]; };
+
+float min3(vec3 v) { return min(v.x, min(v.y, v.z)); }
+float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
+
+void main() {
+    uint size = frame.pass_u.x;
+    uint child = size / 2u;
+    uvec2 block = gl_GlobalInvocationID.xy;
+    uvec2 origin = block * size;
+    if (origin.x + size > frame.width || origin.y + size > frame.height) {
+        return; // partial blocks at the right and bottom edges stay as they are
+    }
+    uint ids[4];
+    ids[0] = origin.y * frame.width + origin.x;
+    ids[1] = ids[0] + child;
+    ids[2] = ids[0] + child * frame.width;
+    ids[3] = ids[2] + child;
+    Fragment f[4];
+    for (int k = 0; k < 4; k++) {
+        f[k] = fragments[ids[k]];
+        if (f[k].size != child) {
+            return; // a child was not (or differently) merged
+        }
+    }
+    float r_min = 1e30;
+    for (int k = 0; k < 4; k++) {
+        r_min = min(r_min, min3(f[k].radius));
+    }
+    if (r_min < frame.merge_min_radius) {
+        return;
+    }
+    float dioptre_spread = 0.0;
+    for (int a = 0; a < 4; a++) {
+        for (int b = a + 1; b < 4; b++) {
+            vec3 dc = abs(f[a].color - f[b].color);
+            if (max3(dc) >= frame.merge_color_tolerance * r_min) {
+                return;
+            }
+            dioptre_spread += abs(f[a].index - f[b].index) * frame.dioptre_step;
+        }
+    }
+    if (dioptre_spread >= 6.0 * frame.merge_dioptre_tolerance * r_min) {
+        return;
+    }
+    Fragment m;
+    m.color = 0.25 * (f[0].color + f[1].color + f[2].color + f[3].color);
+    m.depth = min(min(f[0].depth, f[1].depth), min(f[2].depth, f[3].depth));
+    m.index = 0.25 * (f[0].index + f[1].index + f[2].index + f[3].index);
+    vec3 r_max = max(max(f[0].radius, f[1].radius), max(f[2].radius, f[3].radius));
+    // The block spreads its light over size × size pixels: match the second moment of the
+    // kernel convolved with that block. A block of s×s points adds a variance of (s² − 1)/12
+    // per axis and a disc of radius R has R²/4, so R'² = R² + (s² − 1)/3; children of size c
+    // already carry (c² − 1)/3. (The seed paper adds √2·(s − 1)/2 instead, which over-blurs.)
+    float grow = float(size * size - child * child) / 3.0;
+    m.radius = min(sqrt(r_max * r_max + grow), vec3(float(frame.max_radius)));
+    m.center = vec2(origin) + 0.5 * float(size);
+    m.size = size;
+    m.pad = 0u;
+    fragments[ids[0]] = m;
+    for (int k = 1; k < 4; k++) {
+        fragments[ids[k]].size = 0u;
+    }
+}

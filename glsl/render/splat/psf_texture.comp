@@ -1,0 +1,52 @@
+#version 460
+// Builds the per-frame PSF texture: kernels of up to four (pupil, focus) grid states blended
+// with bilinear weights, laid out as layer = r·No + o, each (2r+1)² block centred at texel Rmax,
+// every other texel zero. Values are scaled by (2r+1)² so that half floats keep their precision
+// (a kernel's mean texel becomes ~1); the convolution pass divides it back out.
+#extension GL_GOOGLE_include_directive : require
+#include "splat.glsl"
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+// The same radius range (chunk) of four kernel sets; texels as packed RGB floats.
+layout(std430, binding = 0) readonly buffer Set0 { float set0[]; };
+layout(std430, binding = 1) readonly buffer Set1 { float set1[]; };
+layout(std430, binding = 2) readonly buffer Set2 { float set2[]; };
+layout(std430, binding = 3) readonly buffer Set3 { float set3[]; };
+layout(binding = 4) writeonly uniform image3D psf_texture;
+
+// pass_f: the four corner weights; pass_u: (first radius, end radius, first texel) of the chunk.
+#define WEIGHTS frame.pass_f
+#define FIRST_RADIUS frame.pass_u.x
+#define END_RADIUS frame.pass_u.y
+#define FIRST_TEXEL frame.pass_u.z
+
+uint texels_below(uint r) {
+    return r * (4u * r * r - 1u) / 3u;
+}
+
+void main() {
+    uint side = 2u * frame.max_radius + 1u;
+    uvec3 id = gl_GlobalInvocationID;
+    uint layer = FIRST_RADIUS * frame.object_count + id.z;
+    if (id.x >= side || id.y >= side || layer >= END_RADIUS * frame.object_count) {
+        return;
+    }
+    uint r = layer / frame.object_count;
+    uint o = layer % frame.object_count;
+    int dx = int(id.x) - int(frame.max_radius);
+    int dy = int(id.y) - int(frame.max_radius);
+    vec3 value = vec3(0.0);
+    if (abs(dx) <= int(r) && abs(dy) <= int(r)) {
+        uint kside = 2u * r + 1u;
+        uint texel = frame.object_count * texels_below(r) + o * kside * kside
+            + uint(dy + int(r)) * kside + uint(dx + int(r)) - FIRST_TEXEL;
+        uint i = 3u * texel;
+        value = WEIGHTS.x * vec3(set0[i], set0[i + 1u], set0[i + 2u]);
+        if (WEIGHTS.y > 0.0) value += WEIGHTS.y * vec3(set1[i], set1[i + 1u], set1[i + 2u]);
+        if (WEIGHTS.z > 0.0) value += WEIGHTS.z * vec3(set2[i], set2[i + 1u], set2[i + 2u]);
+        if (WEIGHTS.w > 0.0) value += WEIGHTS.w * vec3(set3[i], set3[i + 1u], set3[i + 2u]);
+        value *= float(kside * kside);
+    }
+    imageStore(psf_texture, ivec3(id.xy, layer), vec4(value, 0.0));
+}

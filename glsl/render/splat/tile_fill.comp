@@ -1,0 +1,36 @@
+#version 460
+// Appends every fragment to the list of each tile of the current band that its kernel can
+// reach, at the tile's offset from the prefix sum. The fill order depends on scheduling; the
+// sort pass makes the lists deterministic.
+#extension GL_GOOGLE_include_directive : require
+#include "splat.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std430, binding = 0) readonly buffer Fragments { Fragment fragments[]; };
+layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; };
+layout(std430, binding = 2) buffer Cursors { uint cursors[]; };
+layout(std430, binding = 3) writeonly buffer Entries { uvec2 entries[]; };
+
+void main() {
+    uvec2 p = gl_GlobalInvocationID.xy;
+    if (p.x >= frame.width || p.y >= frame.height) {
+        return;
+    }
+    uint index = p.y * frame.width + p.x;
+    Fragment f = fragments[index];
+    if (f.size == 0u) {
+        return;
+    }
+    ivec4 tiles = fragment_tiles(f);
+    // Bands are whole tile rows: clip the rectangle to the band's rows.
+    int band_y0 = int(frame.band_first_tile / frame.tiles_x);
+    int band_y1 = int((frame.band_end_tile - 1u) / frame.tiles_x);
+    for (int ty = max(tiles.y, band_y0); ty <= min(tiles.w, band_y1); ty++) {
+        for (int tx = tiles.x; tx <= tiles.z; tx++) {
+            uint tile = uint(ty) * frame.tiles_x + uint(tx);
+            uint slot = atomicAdd(cursors[tile], 1u);
+            entries[offsets[tile] - frame.band_first_entry + slot] = entry_key(f.depth, index);
+        }
+    }
+}

@@ -1,0 +1,69 @@
+#version 460
+// Sorts each tile's list by (depth, fragment index), one workgroup per tile of the band.
+// Bitonic sorting network in the variant whose comparators all put the smaller key first:
+// then a list of any length n behaves as if padded with +infinity up to a power of two, and
+// every comparator touching the padding can be skipped. Lists up to 2048 entries sort in
+// shared memory; longer ones sort in place in global memory (slower, but nothing is dropped).
+#extension GL_GOOGLE_include_directive : require
+#include "splat.glsl"
+
+layout(local_size_x = 256) in;
+
+layout(std430, binding = 0) readonly buffer Counts { uint counts[]; };
+layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; };
+layout(std430, binding = 2) coherent buffer Entries { uvec2 entries[]; };
+
+const uint SHARED_CAPACITY = 2048u;
+shared uvec2 keys[SHARED_CAPACITY];
+
+void main() {
+    uint tile = frame.band_first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+    if (tile >= frame.band_end_tile) {
+        return; // whole workgroup: no barrier is skipped by some threads only
+    }
+    uint n = counts[tile];
+    if (n < 2u) {
+        return;
+    }
+    uint base = offsets[tile] - frame.band_first_entry;
+    uint t = gl_LocalInvocationID.x;
+    uint m = 1u;
+    while (m < n) m <<= 1u;
+    bool in_shared = n <= SHARED_CAPACITY;
+    if (in_shared) {
+        for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
+        barrier();
+    }
+    for (uint k = 2u; k <= m; k <<= 1u) {
+        for (uint j = k >> 1u; j > 0u; j >>= 1u) {
+            for (uint p = t; p < m / 2u; p += 256u) {
+                uint a, b;
+                if (j == k >> 1u) {
+                    // First step of a merge: compare mirrored positions within the block.
+                    uint block = p / j;
+                    uint offset = p % j;
+                    a = block * k + offset;
+                    b = block * k + k - 1u - offset;
+                } else {
+                    uint block = p / j;
+                    uint offset = p % j;
+                    a = block * 2u * j + offset;
+                    b = a + j;
+                }
+                if (b >= n) continue;
+                if (in_shared) {
+                    uvec2 ka = keys[a], kb = keys[b];
+                    if (key_less(kb, ka)) { keys[a] = kb; keys[b] = ka; }
+                } else {
+                    uvec2 ka = entries[base + a], kb = entries[base + b];
+                    if (key_less(kb, ka)) { entries[base + a] = kb; entries[base + b] = ka; }
+                }
+            }
+            memoryBarrierBuffer();
+            barrier();
+        }
+    }
+    if (in_shared) {
+        for (uint i = t; i < n; i += 256u) entries[base + i] = keys[i];
+    }
+}

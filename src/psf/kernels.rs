@@ -1,0 +1,328 @@
+//! Screen-space convolution kernels: the contract between the PSF precomputation (which fills
+//! them) and the GPU runtime (which turns them into the per-frame PSF texture).
+//!
+//! For one (pupil, focus) state, every object distance `o` on a uniform dioptre axis has a
+//! natural projected PSF radius per channel (in pixels, unrounded) and its PSF resampled to
+//! EVERY integer radius `r = 0..=Rmax`: at run time a fragment's radius is interpolated between
+//! neighbouring object distances and then looked up at floor/ceil radius, so each PSF shape is
+//! needed at radii other than its own.
+//!
+//! Storage order follows the PSF texture (layer = r·No + o): blocks by radius, then object
+//! distance; within a block (2r+1)² texels row-major, each an RGB triple (one channel per
+//! wavelength), each channel normalised to sum 1 over the block.
+
+/// A uniform axis of object vergences in dioptres (1/m): `min_d + i·step_d`, i < count.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DioptreAxis {
+    pub min_d: f64,
+    pub step_d: f64,
+    pub count: usize,
+}
+
+impl DioptreAxis {
+    /// `count` samples from `min_d` to `max_d` inclusive (one sample: `min_d`, step 1).
+    pub fn spanning(min_d: f64, max_d: f64, count: usize) -> DioptreAxis {
+        let step_d = if count > 1 {
+            (max_d - min_d) / (count - 1) as f64
+        } else {
+            1.0
+        };
+        DioptreAxis {
+            min_d,
+            step_d,
+            count,
+        }
+    }
+
+    pub fn value_d(&self, index: usize) -> f64 {
+        self.min_d + index as f64 * self.step_d
+    }
+
+    pub fn max_d(&self) -> f64 {
+        self.value_d(self.count.saturating_sub(1))
+    }
+
+    /// Continuous index of `dioptres` on the axis, clamped to [0, count − 1].
+    pub fn index_of(&self, dioptres: f64) -> f64 {
+        ((dioptres - self.min_d) / self.step_d).clamp(0.0, (self.count.max(1) - 1) as f64)
+    }
+}
+
+/// Number of texels in all blocks of radius below `r`: Σ_{q<r} (2q+1)² = r(4r² − 1)/3.
+pub fn texels_below_radius(r: u32) -> usize {
+    let r = r as usize;
+    r * (4 * r * r).saturating_sub(1) / 3
+}
+
+/// Side of the square kernel of radius `r`.
+pub fn kernel_side(r: u32) -> usize {
+    2 * r as usize + 1
+}
+
+/// The kernels of one (pupil, focus) state for all channels, object distances and radii.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KernelSet {
+    pub pupil_mm: f64,
+    pub focus_d: f64,
+    pub objects: DioptreAxis,
+    pub max_radius_px: u32,
+    /// Natural projected PSF radius in pixels, per object distance, per channel (R, G, B).
+    pub radius_px: Vec<[f32; 3]>,
+    /// All kernel texels in texture order (see the module documentation).
+    pub texels: Vec<[f32; 3]>,
+}
+
+impl KernelSet {
+    /// Texel count of a set with `objects` object distances and radii 0..=max_radius.
+    pub fn texel_count(objects: usize, max_radius: u32) -> usize {
+        objects * texels_below_radius(max_radius + 1)
+    }
+
+    /// A set of zeros, ready to be filled block by block.
+    pub fn zeroed(
+        pupil_mm: f64,
+        focus_d: f64,
+        objects: DioptreAxis,
+        max_radius_px: u32,
+    ) -> KernelSet {
+        KernelSet {
+            pupil_mm,
+            focus_d,
+            objects,
+            max_radius_px,
+            radius_px: vec![[0.0; 3]; objects.count],
+            texels: vec![[0.0; 3]; Self::texel_count(objects.count, max_radius_px)],
+        }
+    }
+
+    /// Index of the first texel of the block for radius `r` and object distance `object`.
+    pub fn block_offset(&self, r: u32, object: usize) -> usize {
+        self.objects.count * texels_below_radius(r) + object * kernel_side(r) * kernel_side(r)
+    }
+
+    pub fn kernel(&self, r: u32, object: usize) -> &[[f32; 3]] {
+        let start = self.block_offset(r, object);
+        &self.texels[start..start + kernel_side(r) * kernel_side(r)]
+    }
+
+    pub fn kernel_mut(&mut self, r: u32, object: usize) -> &mut [[f32; 3]] {
+        let start = self.block_offset(r, object);
+        let side = kernel_side(r);
+        &mut self.texels[start..start + side * side]
+    }
+
+    /// Bytes of the texels as stored for the GPU (three f32 per texel).
+    pub fn size_bytes(&self) -> u64 {
+        self.texels.len() as u64 * 12
+    }
+
+    /// Checks the invariants the runtime relies on; returns the first violation.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.objects.count == 0 || self.objects.step_d.is_nan() || self.objects.step_d <= 0.0 {
+            return Err(format!(
+                "object axis {:?} is empty or not increasing",
+                self.objects
+            ));
+        }
+        if self.radius_px.len() != self.objects.count {
+            return Err("one radius triple per object distance is required".into());
+        }
+        if self.texels.len() != Self::texel_count(self.objects.count, self.max_radius_px) {
+            return Err("texel count does not match the object axis and maximum radius".into());
+        }
+        if let Some(bad) = self
+            .radius_px
+            .iter()
+            .flatten()
+            .find(|r| !r.is_finite() || **r < 0.0)
+        {
+            return Err(format!(
+                "radius {bad} px is not a finite non-negative number"
+            ));
+        }
+        if self.texels.iter().flatten().any(|v| !v.is_finite()) {
+            return Err("kernel texels contain NaN or infinity".into());
+        }
+        Ok(())
+    }
+}
+
+/// Kernels over a grid of (pupil, focus) states sharing one object axis and maximum radius.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KernelGrid {
+    pub pupils_mm: Vec<f64>,
+    pub focus_d: Vec<f64>,
+    pub wavelengths_nm: [f64; 3],
+    pub objects: DioptreAxis,
+    pub max_radius_px: u32,
+    /// Vertical field of view and image height the kernels were projected for.
+    pub fov_y_deg: f64,
+    pub height_px: u32,
+    /// Pupil-major: `sets[p * focus_d.len() + f]`.
+    pub sets: Vec<KernelSet>,
+}
+
+/// Up to four grid sets and their bilinear weights for one (pupil, focus) state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridBlend {
+    pub corners: Vec<(usize, f64)>,
+}
+
+/// Position of `value` on a sorted axis: (lower index, upper index, fraction), clamped.
+fn bracket(axis: &[f64], value: f64) -> (usize, usize, f64) {
+    if axis.len() <= 1 || value <= axis[0] {
+        return (0, 0, 0.0);
+    }
+    let last = axis.len() - 1;
+    if value >= axis[last] {
+        return (last, last, 0.0);
+    }
+    let upper = axis.partition_point(|&a| a <= value).min(last);
+    let lower = upper - 1;
+    let t = (value - axis[lower]) / (axis[upper] - axis[lower]);
+    (lower, upper, t)
+}
+
+impl KernelGrid {
+    pub fn set(&self, pupil_index: usize, focus_index: usize) -> &KernelSet {
+        &self.sets[pupil_index * self.focus_d.len() + focus_index]
+    }
+
+    /// The sets around (pupil, focus) and their bilinear weights (clamped at the grid's edges;
+    /// corners of weight zero are left out).
+    pub fn blend(&self, pupil_mm: f64, focus_d: f64) -> GridBlend {
+        let (p0, p1, tp) = bracket(&self.pupils_mm, pupil_mm);
+        let (f0, f1, tf) = bracket(&self.focus_d, focus_d);
+        let nf = self.focus_d.len();
+        let mut corners: Vec<(usize, f64)> = Vec::with_capacity(4);
+        for (p, wp) in [(p0, 1.0 - tp), (p1, tp)] {
+            for (f, wf) in [(f0, 1.0 - tf), (f1, tf)] {
+                let w = wp * wf;
+                if w <= 0.0 {
+                    continue;
+                }
+                let index = p * nf + f;
+                match corners.iter_mut().find(|(i, _)| *i == index) {
+                    Some(c) => c.1 += w,
+                    None => corners.push((index, w)),
+                }
+            }
+        }
+        GridBlend { corners }
+    }
+
+    /// Natural radii blended like the kernels (what the fragment pass reads each frame).
+    pub fn blended_radii(&self, blend: &GridBlend) -> Vec<[f32; 3]> {
+        let mut out = vec![[0.0f32; 3]; self.objects.count];
+        for &(index, w) in &blend.corners {
+            for (o, r) in self.sets[index].radius_px.iter().enumerate() {
+                for c in 0..3 {
+                    out[o][c] += (w as f32) * r[c];
+                }
+            }
+        }
+        out
+    }
+
+    /// The blended set on the CPU (the GPU's PSF-texture pass does the same per frame).
+    pub fn blended_set(&self, pupil_mm: f64, focus_d: f64) -> KernelSet {
+        let blend = self.blend(pupil_mm, focus_d);
+        let mut out = KernelSet::zeroed(pupil_mm, focus_d, self.objects, self.max_radius_px);
+        out.radius_px = self.blended_radii(&blend);
+        for &(index, w) in &blend.corners {
+            for (dst, src) in out.texels.iter_mut().zip(&self.sets[index].texels) {
+                for c in 0..3 {
+                    dst[c] += w as f32 * src[c];
+                }
+            }
+        }
+        out
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        if self.sets.len() != self.pupils_mm.len() * self.focus_d.len() || self.sets.is_empty() {
+            return Err("one kernel set per (pupil, focus) pair is required".into());
+        }
+        for axis in [&self.pupils_mm, &self.focus_d] {
+            if axis.iter().any(|v| !v.is_finite()) || axis.windows(2).any(|w| w[1] <= w[0]) {
+                return Err("pupil and focus axes must be strictly increasing".into());
+            }
+        }
+        for set in &self.sets {
+            if set.objects != self.objects || set.max_radius_px != self.max_radius_px {
+                return Err(
+                    "every set must share the grid's object axis and maximum radius".into(),
+                );
+            }
+            set.validate()?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texel_counts_match_a_direct_sum() {
+        for r in 0..60u32 {
+            let direct: usize = (0..r).map(|q| kernel_side(q) * kernel_side(q)).sum();
+            assert_eq!(texels_below_radius(r), direct, "r = {r}");
+        }
+        // The paper's figure: Rmax 48, 41 object distances, 3 channels of f32 ≈ 74 MiB.
+        let bytes = KernelSet::texel_count(41, 48) * 12;
+        assert!(
+            (bytes as f64 / (1 << 20) as f64 - 73.6).abs() < 0.5,
+            "{bytes}"
+        );
+    }
+
+    #[test]
+    fn blocks_tile_the_texel_array_without_gaps() {
+        let set = KernelSet::zeroed(4.0, 0.0, DioptreAxis::spanning(0.0, 2.0, 5), 6);
+        let mut expected = 0;
+        for r in 0..=6 {
+            for o in 0..5 {
+                assert_eq!(set.block_offset(r, o), expected);
+                expected += kernel_side(r) * kernel_side(r);
+            }
+        }
+        assert_eq!(expected, set.texels.len());
+    }
+
+    #[test]
+    fn blend_weights_are_bilinear_and_sum_to_one() {
+        let objects = DioptreAxis::spanning(0.0, 1.0, 2);
+        let grid = KernelGrid {
+            pupils_mm: vec![2.0, 4.0, 6.0],
+            focus_d: vec![0.0, 2.0],
+            wavelengths_nm: [612.0, 549.0, 464.0],
+            objects,
+            max_radius_px: 1,
+            fov_y_deg: 60.0,
+            height_px: 90,
+            sets: (0..6)
+                .map(|_| KernelSet::zeroed(0.0, 0.0, objects, 1))
+                .collect(),
+        };
+        let b = grid.blend(5.0, 0.5);
+        let total: f64 = b.corners.iter().map(|c| c.1).sum();
+        assert!((total - 1.0).abs() < 1e-12);
+        // pupil 5 = halfway 4..6 (indices 1, 2); focus 0.5 = quarter 0..2.
+        let weight = |i: usize| {
+            b.corners
+                .iter()
+                .find(|c| c.0 == i)
+                .map(|c| c.1)
+                .unwrap_or(0.0)
+        };
+        assert!((weight(2) - 0.5 * 0.75).abs() < 1e-12);
+        assert!((weight(3) - 0.5 * 0.25).abs() < 1e-12);
+        assert!((weight(4) - 0.5 * 0.75).abs() < 1e-12);
+        // Exactly on a grid point: one corner.
+        assert_eq!(grid.blend(4.0, 2.0).corners, vec![(3, 1.0)]);
+        // Outside: clamped.
+        assert_eq!(grid.blend(9.0, -1.0).corners, vec![(4, 1.0)]);
+    }
+}

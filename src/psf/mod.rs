@@ -1,0 +1,3 @@
+//! Point-spread functions turned into screen-space kernels (pure numerics, no GPU).
+
+pub mod kernels;

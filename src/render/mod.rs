@@ -1,0 +1,4 @@
+//! Rendering: joins the eye's kernels (`psf`) with the GPU layer (`gpu`).
+
+pub mod reference;
+pub mod splat;

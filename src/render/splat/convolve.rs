@@ -1,0 +1,59 @@
+//! Convolution pass: front-to-back blending of each tile's sorted fragments through the PSF
+//! texture. See glsl/render/splat/convolve.comp.
+
+use crate::gpu::{
+    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Sampler,
+};
+
+use super::tile_fill::per_tile_groups;
+use super::FrameParams;
+
+pub(super) struct ConvolvePass {
+    pipeline: ComputePipeline,
+}
+
+impl ConvolvePass {
+    pub fn new(ctx: &Context) -> GpuResult<Self> {
+        let pipeline =
+            ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
+                .bindings(&[
+                    BindingKind::SampledImage,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageImage,
+                ])
+                .push_constants::<FrameParams>()
+                .build(ctx)?;
+        Ok(ConvolvePass { pipeline })
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        params: &FrameParams,
+        band_tiles: u32,
+        psf: (&Image, &Sampler),
+        fragments: &Buffer,
+        counts: &Buffer,
+        offsets: &Buffer,
+        entries: &Buffer,
+        output: &Image,
+    ) -> GpuResult<()> {
+        rec.dispatch(
+            &self.pipeline,
+            &[
+                Binding::Sampled(psf.0, psf.1),
+                Binding::Buffer(fragments),
+                Binding::Buffer(counts),
+                Binding::Buffer(offsets),
+                Binding::Buffer(entries),
+                Binding::Storage(output),
+            ],
+            params,
+            per_tile_groups(band_tiles),
+        )
+    }
+}

@@ -1,0 +1,661 @@
+//! Tiled PSF splatting on the GPU (Csoba & Kunkli 2021, after Franke et al. 2018).
+//!
+//! Per frame: PSF texture (blend the kernel grid over pupil and focus) → fragments (one per
+//! pixel) → merge (optional 2×2 / 4×4 blocks) → tile count → prefix sum → [per band of tile
+//! rows: fill → sort → convolve]. List memory is exact (count → prefix sum → fill); when a
+//! frame's lists exceed the device's storage-buffer binding limit or the memory budget, the
+//! screen is processed in bands of tile rows, so nothing is ever dropped.
+//!
+//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`.
+
+mod convolve;
+mod fragments;
+mod merge;
+mod prefix_sum;
+mod psf_texture;
+mod tile_count;
+mod tile_fill;
+mod tile_sort;
+
+use crate::gpu::{
+    Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings,
+};
+use crate::psf::kernels::KernelGrid;
+
+pub use psf_texture::PsfTextureFormat;
+
+/// Mirrors `struct Fragment` in glsl/common/splat.glsl (std430, 48 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Fragment {
+    pub color: [f32; 3],
+    pub depth: f32,
+    pub radius: [f32; 3],
+    pub index: f32,
+    pub center: [f32; 2],
+    pub size: u32,
+    pub pad: u32,
+}
+
+/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (96 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct FrameParams {
+    pub width: u32,
+    pub height: u32,
+    pub tiles_x: u32,
+    pub tiles_y: u32,
+    pub tile_size: u32,
+    pub object_count: u32,
+    pub max_radius: u32,
+    pub fragment_count: u32,
+    pub dioptre_min: f32,
+    pub dioptre_step: f32,
+    pub merge_min_radius: f32,
+    pub merge_color_tolerance: f32,
+    pub merge_dioptre_tolerance: f32,
+    pub band_first_tile: u32,
+    pub band_end_tile: u32,
+    pub band_first_entry: u32,
+    pub pass_u: [u32; 4],
+    pub pass_f: [f32; 4],
+}
+
+/// When and how strongly blurred blocks are merged into one fragment.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MergeSettings {
+    /// 0 = off, 1 = 2×2 blocks, 2 = 2×2 and then 4×4 blocks.
+    pub levels: u32,
+    /// Smallest blur radius (px, over the block and the channels) for a block to merge.
+    pub min_radius_px: f32,
+    /// Largest colour difference between two fragments of a block, per pixel of blur radius.
+    pub color_tolerance: f32,
+    /// Largest summed pairwise dioptre difference in a block, per pair and pixel of blur.
+    pub dioptre_tolerance: f32,
+}
+
+impl Default for MergeSettings {
+    fn default() -> Self {
+        // The seed paper's framework defaults.
+        MergeSettings {
+            levels: 1,
+            min_radius_px: 5.0,
+            color_tolerance: 0.10,
+            dioptre_tolerance: 0.01,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SplatSettings {
+    /// Screen tile side in pixels: 8, 16 or 32.
+    pub tile_size: u32,
+    pub texture_format: PsfTextureFormat,
+    pub merge: MergeSettings,
+    /// Upper bound on the tile-list buffer (bytes); bands are used beyond it. The device's
+    /// storage-buffer binding limit applies as well.
+    pub max_list_bytes: u64,
+}
+
+impl Default for SplatSettings {
+    fn default() -> Self {
+        SplatSettings {
+            tile_size: 8,
+            texture_format: PsfTextureFormat::Rgba16Float,
+            merge: MergeSettings::default(),
+            max_list_bytes: 1 << 30,
+        }
+    }
+}
+
+impl SplatSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if ![8, 16, 32].contains(&self.tile_size) {
+            return Err(format!(
+                "tile size {} is not one of 8, 16, 32",
+                self.tile_size
+            ));
+        }
+        if self.merge.levels > 2 {
+            return Err(format!(
+                "merge levels {} is not 0, 1 or 2",
+                self.merge.levels
+            ));
+        }
+        if !(self.merge.min_radius_px >= 0.0
+            && self.merge.color_tolerance >= 0.0
+            && self.merge.dioptre_tolerance >= 0.0)
+        {
+            return Err("merge thresholds must be non-negative numbers".into());
+        }
+        Ok(())
+    }
+}
+
+/// A colour + depth frame on the CPU: row-major, top row first.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameInput<'a> {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB (alpha ignored), HDR allowed.
+    pub color: &'a [[f32; 4]],
+    /// Distance along the view axis in metres; 0, negative or infinite = optical infinity.
+    pub depth_m: &'a [f32],
+}
+
+/// The eye's state for one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewState {
+    pub pupil_mm: f64,
+    pub focus_d: f64,
+}
+
+/// What a frame cost in list memory, for reports and tests.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct SplatStats {
+    pub fragments: u64,
+    pub live_fragments: u64,
+    pub list_entries: u64,
+    pub max_entries_per_tile: u64,
+    pub bands: u32,
+}
+
+/// Intermediate buffers of a single-band frame, read back for tests.
+#[derive(Clone, Debug, Default)]
+pub struct SplatIntermediates {
+    pub fragments: Vec<Fragment>,
+    pub counts: Vec<u32>,
+    pub offsets: Vec<u32>,
+    pub entries: Vec<[u32; 2]>,
+}
+
+pub struct SplatOutput {
+    pub color: Vec<[f32; 4]>,
+    pub timings: Timings,
+    pub stats: SplatStats,
+    pub intermediates: Option<SplatIntermediates>,
+}
+
+/// Frame-size-dependent GPU resources, rebuilt when the size changes.
+struct FrameResources {
+    width: u32,
+    height: u32,
+    tiles_x: u32,
+    tiles_y: u32,
+    color_in: Image,
+    depth_in: Image,
+    color_out: Image,
+    fragments: Buffer,
+    counts: Buffer,
+    cursors: Buffer,
+    offsets: Buffer,
+    block_sums: Buffer,
+}
+
+pub struct Splatter {
+    ctx: Context,
+    settings: SplatSettings,
+    grid: KernelGrid,
+    resident: psf_texture::ResidentGrid,
+    texture: Image,
+    sampler: Sampler,
+    radii: Buffer,
+    frame: Option<FrameResources>,
+    entries: Option<Buffer>,
+    psf_texture: psf_texture::PsfTexturePass,
+    fragments_pass: fragments::FragmentsPass,
+    merge: merge::MergePass,
+    tile_count: tile_count::TileCountPass,
+    prefix_sum: prefix_sum::PrefixSumPass,
+    tile_fill: tile_fill::TileFillPass,
+    tile_sort: tile_sort::TileSortPass,
+    convolve: convolve::ConvolvePass,
+}
+
+const FRAGMENT_BYTES: u64 = std::mem::size_of::<Fragment>() as u64;
+const ENTRY_BYTES: u64 = 8;
+
+fn binding_limit(ctx: &Context) -> u64 {
+    u64::from(ctx.limits().max_storage_buffer_range)
+}
+
+impl Splatter {
+    /// Uploads `grid` and builds every pass. The grid stays resident on the GPU.
+    pub fn new(
+        ctx: &Context,
+        grid: KernelGrid,
+        settings: SplatSettings,
+    ) -> crate::Result<Splatter> {
+        settings.validate().map_err(crate::Error::Input)?;
+        grid.validate()
+            .map_err(|e| crate::Error::Input(format!("kernel grid: {e}")))?;
+        if !ctx.can_write_images_without_format() {
+            return Err(GpuError::Unsupported(
+                "shaderStorageImageWriteWithoutFormat (needed to build the PSF texture)".into(),
+            )
+            .into());
+        }
+        let resident = psf_texture::ResidentGrid::upload(ctx, &grid)?;
+        let texture = psf_texture::create_texture(ctx, &grid, settings.texture_format)?;
+        let radii = Buffer::new(
+            ctx,
+            "object radii",
+            grid.objects.count as u64 * 16,
+            Residency::Device,
+        )?;
+        Ok(Splatter {
+            ctx: ctx.clone(),
+            settings,
+            resident,
+            texture,
+            sampler: Sampler::linear(ctx, Edge::ZeroBorder)?,
+            radii,
+            frame: None,
+            entries: None,
+            psf_texture: psf_texture::PsfTexturePass::new(ctx)?,
+            fragments_pass: fragments::FragmentsPass::new(ctx)?,
+            merge: merge::MergePass::new(ctx)?,
+            tile_count: tile_count::TileCountPass::new(ctx)?,
+            prefix_sum: prefix_sum::PrefixSumPass::new(ctx)?,
+            tile_fill: tile_fill::TileFillPass::new(ctx)?,
+            tile_sort: tile_sort::TileSortPass::new(ctx)?,
+            convolve: convolve::ConvolvePass::new(ctx)?,
+            grid,
+        })
+    }
+
+    pub fn grid(&self) -> &KernelGrid {
+        &self.grid
+    }
+
+    pub fn settings(&self) -> &SplatSettings {
+        &self.settings
+    }
+
+    /// The PSF texture as the convolution pass samples it (for inspection and tests).
+    pub fn psf_texture(&self) -> (&Image, &Sampler) {
+        (&self.texture, &self.sampler)
+    }
+
+    fn ensure_frame(&mut self, width: u32, height: u32) -> crate::Result<()> {
+        if self
+            .frame
+            .as_ref()
+            .is_some_and(|f| f.width == width && f.height == height)
+        {
+            return Ok(());
+        }
+        let ctx = &self.ctx;
+        let pixels = u64::from(width) * u64::from(height);
+        let limit = binding_limit(ctx);
+        if pixels * FRAGMENT_BYTES > limit {
+            return Err(crate::Error::input(format!(
+                "a {width}×{height} frame needs {} MiB of fragments, over this device's {} MiB storage-buffer \
+                 binding limit; render at most {} pixels per frame on this device",
+                (pixels * FRAGMENT_BYTES) >> 20,
+                limit >> 20,
+                limit / FRAGMENT_BYTES
+            )));
+        }
+        let tile = self.settings.tile_size;
+        let (tiles_x, tiles_y) = (width.div_ceil(tile), height.div_ceil(tile));
+        let tiles = u64::from(tiles_x) * u64::from(tiles_y);
+        let storage = ImageUsage::STORAGE;
+        self.frame = Some(FrameResources {
+            width,
+            height,
+            tiles_x,
+            tiles_y,
+            color_in: Image::new_2d(
+                ctx,
+                "input colour",
+                width,
+                height,
+                TexelFormat::Rgba32Float,
+                storage,
+            )?,
+            depth_in: Image::new_2d(
+                ctx,
+                "input depth",
+                width,
+                height,
+                TexelFormat::R32Float,
+                storage,
+            )?,
+            color_out: Image::new_2d(
+                ctx,
+                "splat output",
+                width,
+                height,
+                TexelFormat::Rgba32Float,
+                storage,
+            )?,
+            fragments: Buffer::new(ctx, "fragments", pixels * FRAGMENT_BYTES, Residency::Device)?,
+            counts: Buffer::new(ctx, "tile counts", (tiles + 1) * 4, Residency::Device)?,
+            cursors: Buffer::new(ctx, "tile cursors", tiles * 4, Residency::Device)?,
+            offsets: Buffer::new(ctx, "tile offsets", (tiles + 1) * 4, Residency::Device)?,
+            block_sums: Buffer::new(
+                ctx,
+                "scan block sums",
+                tiles.div_ceil(1024) * 4,
+                Residency::Device,
+            )?,
+        });
+        Ok(())
+    }
+
+    fn params(&self, frame: &FrameResources) -> FrameParams {
+        let merge = &self.settings.merge;
+        FrameParams {
+            width: frame.width,
+            height: frame.height,
+            tiles_x: frame.tiles_x,
+            tiles_y: frame.tiles_y,
+            tile_size: self.settings.tile_size,
+            object_count: self.grid.objects.count as u32,
+            max_radius: self.grid.max_radius_px,
+            fragment_count: frame.width * frame.height,
+            dioptre_min: self.grid.objects.min_d as f32,
+            dioptre_step: self.grid.objects.step_d as f32,
+            merge_min_radius: merge.min_radius_px,
+            merge_color_tolerance: merge.color_tolerance,
+            merge_dioptre_tolerance: merge.dioptre_tolerance,
+            band_first_tile: 0,
+            band_end_tile: frame.tiles_x * frame.tiles_y,
+            band_first_entry: 0,
+            pass_u: [0; 4],
+            pass_f: [0.0; 4],
+        }
+    }
+
+    /// Renders one frame through the eye's kernels for `view`.
+    pub fn render(
+        &mut self,
+        input: &FrameInput<'_>,
+        view: ViewState,
+        keep_intermediates: bool,
+    ) -> crate::Result<SplatOutput> {
+        let (w, h) = (input.width, input.height);
+        let pixels = w as usize * h as usize;
+        if w == 0 || h == 0 || input.color.len() != pixels || input.depth_m.len() != pixels {
+            return Err(crate::Error::input(format!(
+                "frame of {w}×{h} needs {pixels} colour and depth values (got {} and {})",
+                input.color.len(),
+                input.depth_m.len()
+            )));
+        }
+        if !(view.pupil_mm.is_finite() && view.pupil_mm > 0.0 && view.focus_d.is_finite()) {
+            return Err(crate::Error::input(format!(
+                "pupil {} mm / focus {} D must be finite, pupil positive",
+                view.pupil_mm, view.focus_d
+            )));
+        }
+        self.ensure_frame(w, h)?;
+        let ctx = self.ctx.clone();
+        let frame = self.frame.as_ref().expect("ensured above");
+        frame.color_in.upload(&ctx, input.color)?;
+        frame.depth_in.upload(&ctx, input.depth_m)?;
+        let blend = self.grid.blend(view.pupil_mm, view.focus_d);
+        let radii: Vec<[f32; 4]> = self
+            .grid
+            .blended_radii(&blend)
+            .iter()
+            .map(|r| [r[0], r[1], r[2], 0.0])
+            .collect();
+        let params = self.params(frame);
+        let tiles = frame.tiles_x * frame.tiles_y;
+
+        // Submission 1: everything up to the exact list size.
+        let mut timings = ctx.submit(|rec| {
+            rec.upload_buffer(&self.radii, &radii)?;
+            rec.begin_pass("psf texture");
+            self.psf_texture
+                .record(rec, &params, &self.resident, &blend, &self.texture)?;
+            rec.begin_pass("fragments");
+            self.fragments_pass.record(
+                rec,
+                &params,
+                &frame.color_in,
+                &frame.depth_in,
+                &self.radii,
+                &frame.fragments,
+            )?;
+            if self.settings.merge.levels > 0 {
+                rec.begin_pass("merge");
+                self.merge
+                    .record(rec, &params, self.settings.merge.levels, &frame.fragments)?;
+            }
+            rec.begin_pass("tile count");
+            rec.fill_buffer(&frame.counts, 0);
+            self.tile_count
+                .record(rec, &params, &frame.fragments, &frame.counts)?;
+            rec.begin_pass("prefix sum");
+            self.prefix_sum.record(
+                rec,
+                &params,
+                tiles,
+                &frame.counts,
+                &frame.offsets,
+                &frame.block_sums,
+            )?;
+            rec.end_pass();
+            Ok(())
+        })?;
+        // The counts buffer ends with the number of live (not merged-away) fragments.
+        let counts_and_live: Vec<u32> = frame.counts.read(&ctx)?;
+        let offsets: Vec<u32> = frame.offsets.read(&ctx)?;
+        let counts = &counts_and_live[..tiles as usize];
+        let total: u64 = counts.iter().map(|&c| u64::from(c)).sum();
+        if total != u64::from(offsets[tiles as usize]) {
+            return Err(GpuError::Usage {
+                pass: "prefix sum".into(),
+                message: format!(
+                    "list total {} disagrees with the counts' sum {total} (more than 2³² entries?)",
+                    offsets[tiles as usize]
+                ),
+            }
+            .into());
+        }
+        let bands = plan_bands(counts, frame.tiles_x, self.list_capacity_entries())?;
+
+        // Submission 2: lists, sorting and convolution, band by band.
+        let largest_band = bands.iter().map(|b| b.entries).max().unwrap_or(0);
+        self.ensure_entries(largest_band)?;
+        let frame = self.frame.as_ref().expect("ensured above");
+        let entries = self.entries.as_ref().expect("ensured above");
+        let band_timings = ctx.submit(|rec| {
+            for band in &bands {
+                let mut p = params;
+                p.band_first_tile = band.first_tile;
+                p.band_end_tile = band.end_tile;
+                p.band_first_entry = band.first_entry;
+                rec.begin_pass("tile fill");
+                rec.fill_buffer(&frame.cursors, 0);
+                self.tile_fill.record(
+                    rec,
+                    &p,
+                    &frame.fragments,
+                    &frame.offsets,
+                    &frame.cursors,
+                    entries,
+                )?;
+                rec.begin_pass("tile sort");
+                self.tile_sort.record(
+                    rec,
+                    &p,
+                    band.end_tile - band.first_tile,
+                    &frame.counts,
+                    &frame.offsets,
+                    entries,
+                )?;
+                rec.begin_pass("convolve");
+                self.convolve.record(
+                    rec,
+                    &p,
+                    band.end_tile - band.first_tile,
+                    (&self.texture, &self.sampler),
+                    &frame.fragments,
+                    &frame.counts,
+                    &frame.offsets,
+                    entries,
+                    &frame.color_out,
+                )?;
+            }
+            rec.end_pass();
+            Ok(())
+        })?;
+        timings.extend(band_timings);
+        let color: Vec<[f32; 4]> = frame.color_out.read(&ctx)?;
+
+        let live = u64::from(counts_and_live[tiles as usize]);
+        let stats = SplatStats {
+            fragments: pixels as u64,
+            live_fragments: live,
+            list_entries: total,
+            max_entries_per_tile: counts.iter().copied().max().unwrap_or(0).into(),
+            bands: bands.len() as u32,
+        };
+        let intermediates = if keep_intermediates {
+            let mut all_entries: Vec<[u32; 2]> = entries.read(&ctx)?;
+            all_entries.truncate(if bands.len() == 1 { total as usize } else { 0 });
+            let fragments: Vec<Fragment> = frame.fragments.read(&ctx)?;
+            Some(SplatIntermediates {
+                fragments,
+                counts: counts.to_vec(),
+                offsets: offsets.to_vec(),
+                entries: all_entries,
+            })
+        } else {
+            None
+        };
+        Ok(SplatOutput {
+            color,
+            timings: merge_repeated(timings),
+            stats,
+            intermediates,
+        })
+    }
+
+    /// Entries one band may hold: the binding limit, the memory budget, and a test override.
+    fn list_capacity_entries(&self) -> u64 {
+        binding_limit(&self.ctx).min(self.settings.max_list_bytes) / ENTRY_BYTES
+    }
+
+    fn ensure_entries(&mut self, entries: u64) -> crate::Result<()> {
+        let needed = entries.max(1) * ENTRY_BYTES;
+        if self
+            .entries
+            .as_ref()
+            .is_some_and(|b| b.size_bytes() >= needed)
+        {
+            return Ok(());
+        }
+        // Grow with headroom so that small frame-to-frame changes do not reallocate.
+        let size = (needed + needed / 4)
+            .min(self.list_capacity_entries() * ENTRY_BYTES)
+            .max(needed);
+        self.entries = None;
+        self.entries = Some(Buffer::new(
+            &self.ctx,
+            "tile lists",
+            size,
+            Residency::Device,
+        )?);
+        Ok(())
+    }
+}
+
+/// A range of whole tile rows processed together, and where its entries start in the global
+/// (prefix-sum) numbering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Band {
+    pub first_tile: u32,
+    pub end_tile: u32,
+    pub first_entry: u32,
+    pub entries: u64,
+}
+
+/// Splits the screen into bands of whole tile rows whose lists fit `capacity` entries.
+pub(crate) fn plan_bands(counts: &[u32], tiles_x: u32, capacity: u64) -> crate::Result<Vec<Band>> {
+    let rows = counts.len() as u32 / tiles_x.max(1);
+    let mut bands = Vec::new();
+    let mut start_row = 0u32;
+    let mut first_entry = 0u64;
+    let mut entries = 0u64;
+    for row in 0..rows {
+        let row_entries: u64 = counts[(row * tiles_x) as usize..((row + 1) * tiles_x) as usize]
+            .iter()
+            .map(|&c| u64::from(c))
+            .sum();
+        if row_entries > capacity {
+            return Err(crate::Error::input(format!(
+                "one row of tiles needs {row_entries} list entries ({} MiB), over the {} MiB a band may use on this device; \
+                 lower the frame size, enable fragment merging, or use a larger tile size",
+                (row_entries * ENTRY_BYTES) >> 20,
+                (capacity * ENTRY_BYTES) >> 20
+            )));
+        }
+        if entries + row_entries > capacity && row > start_row {
+            bands.push(Band {
+                first_tile: start_row * tiles_x,
+                end_tile: row * tiles_x,
+                first_entry: first_entry as u32,
+                entries,
+            });
+            start_row = row;
+            first_entry += entries;
+            entries = 0;
+        }
+        entries += row_entries;
+    }
+    bands.push(Band {
+        first_tile: start_row * tiles_x,
+        end_tile: rows * tiles_x,
+        first_entry: first_entry as u32,
+        entries,
+    });
+    Ok(bands)
+}
+
+/// Sums the timings of passes that ran once per band, keeping first-seen order.
+fn merge_repeated(timings: Timings) -> Timings {
+    let mut out = Timings::default();
+    for pass in timings.passes {
+        match out.passes.iter_mut().find(|p| p.name == pass.name) {
+            Some(existing) => existing.ms += pass.ms,
+            None => out.passes.push(pass),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bands_cover_every_row_once_and_respect_capacity() {
+        let tiles_x = 3;
+        let counts = [5, 5, 5, 1, 1, 1, 9, 0, 0, 2, 2, 2];
+        let bands = plan_bands(&counts, tiles_x, 10).unwrap();
+        assert_eq!(
+            bands
+                .iter()
+                .map(|b| (b.first_tile, b.end_tile))
+                .collect::<Vec<_>>(),
+            [(0, 3), (3, 6), (6, 9), (9, 12)]
+        );
+        let bands = plan_bands(&counts, tiles_x, 20).unwrap();
+        assert_eq!(
+            bands
+                .iter()
+                .map(|b| (b.first_tile, b.end_tile, b.first_entry))
+                .collect::<Vec<_>>(),
+            [(0, 6, 0), (6, 12, 18)]
+        );
+        assert!(bands.iter().all(|b| b.entries <= 20));
+        assert_eq!(plan_bands(&counts, tiles_x, 1000).unwrap().len(), 1);
+        let err = plan_bands(&counts, tiles_x, 14).unwrap_err().to_string();
+        assert!(err.contains("one row of tiles needs 15"), "{err}");
+    }
+}

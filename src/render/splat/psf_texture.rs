@@ -1,0 +1,213 @@
+//! PSF texture pass: blends the resident kernel sets of up to four (pupil, focus) grid states
+//! into the 3D texture the convolution samples. See glsl/render/splat/psf_texture.comp.
+
+use crate::gpu::{
+    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage, Recorder,
+    TexelFormat,
+};
+use crate::psf::kernels::{texels_below_radius, GridBlend, KernelGrid, KernelSet};
+
+use super::FrameParams;
+
+/// Texel format of the PSF texture: half floats halve memory and bandwidth; kernels are
+/// stored scaled by (2r+1)² so that half precision keeps about three significant digits.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum PsfTextureFormat {
+    #[value(name = "rgba16f")]
+    #[serde(rename = "rgba16f")]
+    Rgba16Float,
+    #[value(name = "rgba32f")]
+    #[serde(rename = "rgba32f")]
+    Rgba32Float,
+}
+
+impl PsfTextureFormat {
+    pub fn texel_format(self) -> TexelFormat {
+        match self {
+            PsfTextureFormat::Rgba16Float => TexelFormat::Rgba16Float,
+            PsfTextureFormat::Rgba32Float => TexelFormat::Rgba32Float,
+        }
+    }
+}
+
+/// Extent of the PSF texture for a grid: (2Rmax+1)² × No·(Rmax+1).
+pub fn texture_extent(grid: &KernelGrid) -> [u32; 3] {
+    let side = 2 * grid.max_radius_px + 1;
+    [
+        side,
+        side,
+        grid.objects.count as u32 * (grid.max_radius_px + 1),
+    ]
+}
+
+pub(super) fn create_texture(
+    ctx: &Context,
+    grid: &KernelGrid,
+    format: PsfTextureFormat,
+) -> GpuResult<Image> {
+    let usage = ImageUsage {
+        storage: true,
+        ..ImageUsage::SAMPLED
+    };
+    Image::new_3d(
+        ctx,
+        "PSF texture",
+        texture_extent(grid),
+        format.texel_format(),
+        usage,
+    )
+}
+
+/// One set's texels for the radii [first_radius, end_radius), small enough for one binding.
+pub(super) struct Chunk {
+    buffer: Buffer,
+    first_radius: u32,
+    end_radius: u32,
+    first_texel: u32,
+}
+
+/// Every kernel set of the grid, on the GPU, split into chunks by radius range (the same
+/// ranges for every set, so a dispatch can read one chunk of each of four sets).
+pub(super) struct ResidentGrid {
+    /// `sets[set][chunk]`.
+    sets: Vec<Vec<Chunk>>,
+}
+
+/// Radius ranges whose texels fit `limit_bytes` each.
+fn chunk_ranges(objects: usize, max_radius: u32, limit_bytes: u64) -> Vec<(u32, u32)> {
+    let bytes_of =
+        |a: u32, b: u32| (objects * (texels_below_radius(b) - texels_below_radius(a))) as u64 * 12;
+    let mut ranges = Vec::new();
+    let mut start = 0;
+    while start <= max_radius {
+        let mut end = start + 1;
+        while end <= max_radius && bytes_of(start, end + 1) <= limit_bytes {
+            end += 1;
+        }
+        ranges.push((start, end));
+        start = end;
+    }
+    ranges
+}
+
+impl ResidentGrid {
+    pub fn upload(ctx: &Context, grid: &KernelGrid) -> GpuResult<ResidentGrid> {
+        let limit = u64::from(ctx.limits().max_storage_buffer_range);
+        let ranges = chunk_ranges(grid.objects.count, grid.max_radius_px, limit);
+        let sets = grid
+            .sets
+            .iter()
+            .enumerate()
+            .map(|(i, set)| upload_set(ctx, i, set, &ranges))
+            .collect::<GpuResult<Vec<_>>>()?;
+        Ok(ResidentGrid { sets })
+    }
+}
+
+fn upload_set(
+    ctx: &Context,
+    index: usize,
+    set: &KernelSet,
+    ranges: &[(u32, u32)],
+) -> GpuResult<Vec<Chunk>> {
+    let objects = set.objects.count;
+    ranges
+        .iter()
+        .map(|&(a, b)| {
+            let first = objects * texels_below_radius(a);
+            let end = objects * texels_below_radius(b);
+            let buffer = Buffer::from_slice(
+                ctx,
+                &format!("kernel set {index} radii {a}..{b}"),
+                &set.texels[first..end],
+            )?;
+            Ok(Chunk {
+                buffer,
+                first_radius: a,
+                end_radius: b,
+                first_texel: first as u32,
+            })
+        })
+        .collect()
+}
+
+pub(super) struct PsfTexturePass {
+    pipeline: ComputePipeline,
+}
+
+impl PsfTexturePass {
+    pub fn new(ctx: &Context) -> GpuResult<Self> {
+        let pipeline =
+            ComputePipeline::builder("psf texture", crate::shaders::RENDER_SPLAT_PSF_TEXTURE_COMP)
+                .bindings(&[
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageImage,
+                ])
+                .push_constants::<FrameParams>()
+                .build(ctx)?;
+        Ok(PsfTexturePass { pipeline })
+    }
+
+    pub fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        params: &FrameParams,
+        grid: &ResidentGrid,
+        blend: &GridBlend,
+        texture: &Image,
+    ) -> GpuResult<()> {
+        let [side, _, _] = texture.extent();
+        let chunks = grid.sets[blend.corners[0].0].len();
+        for chunk in 0..chunks {
+            // Unused corners repeat the first one with weight zero (never read).
+            let corner =
+                |k: usize| &grid.sets[blend.corners.get(k).unwrap_or(&blend.corners[0]).0][chunk];
+            let weight = |k: usize| blend.corners.get(k).map_or(0.0, |c| c.1 as f32);
+            let first = corner(0);
+            let mut p = *params;
+            p.pass_u = [first.first_radius, first.end_radius, first.first_texel, 0];
+            p.pass_f = [weight(0), weight(1), weight(2), weight(3)];
+            let layers = (first.end_radius - first.first_radius) * params.object_count;
+            rec.dispatch(
+                &self.pipeline,
+                &[
+                    Binding::Buffer(&corner(0).buffer),
+                    Binding::Buffer(&corner(1).buffer),
+                    Binding::Buffer(&corner(2).buffer),
+                    Binding::Buffer(&corner(3).buffer),
+                    Binding::Storage(texture),
+                ],
+                &p,
+                [side.div_ceil(8), side.div_ceil(8), layers],
+            )?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_cover_all_radii_within_the_limit() {
+        for limit in [1u64 << 10, 1 << 16, 128 << 20] {
+            let ranges = chunk_ranges(41, 48, limit);
+            assert_eq!(ranges.first().unwrap().0, 0);
+            assert_eq!(ranges.last().unwrap().1, 49);
+            for w in ranges.windows(2) {
+                assert_eq!(w[0].1, w[1].0);
+            }
+            for &(a, b) in &ranges {
+                let bytes = (41 * (texels_below_radius(b) - texels_below_radius(a))) as u64 * 12;
+                assert!(bytes <= limit || b == a + 1, "{a}..{b}: {bytes} > {limit}");
+            }
+        }
+    }
+}

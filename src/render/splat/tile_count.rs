@@ -1,0 +1,37 @@
+//! Tile-count pass: how many fragments each screen tile's list will hold (exact overlap of the
+//! kernel's square support with the tile). See glsl/render/splat/tile_count.comp.
+
+use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+
+use super::FrameParams;
+
+pub(super) struct TileCountPass {
+    pipeline: ComputePipeline,
+}
+
+impl TileCountPass {
+    pub fn new(ctx: &Context) -> GpuResult<Self> {
+        let pipeline =
+            ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
+                .bindings(&[BindingKind::StorageBuffer, BindingKind::StorageBuffer])
+                .push_constants::<FrameParams>()
+                .build(ctx)?;
+        Ok(TileCountPass { pipeline })
+    }
+
+    /// `counts` must be zeroed (tiles + 1 elements; the last counts live fragments).
+    pub fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        params: &FrameParams,
+        fragments: &Buffer,
+        counts: &Buffer,
+    ) -> GpuResult<()> {
+        rec.dispatch(
+            &self.pipeline,
+            &[Binding::Buffer(fragments), Binding::Buffer(counts)],
+            params,
+            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+        )
+    }
+}

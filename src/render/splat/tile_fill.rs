@@ -1,0 +1,56 @@
+//! Tile-fill pass: writes each fragment's (depth, index) key into the list of every tile of
+//! the current band it reaches. See glsl/render/splat/tile_fill.comp.
+
+use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+
+use super::FrameParams;
+
+pub(super) struct TileFillPass {
+    pipeline: ComputePipeline,
+}
+
+impl TileFillPass {
+    pub fn new(ctx: &Context) -> GpuResult<Self> {
+        let pipeline =
+            ComputePipeline::builder("tile fill", crate::shaders::RENDER_SPLAT_TILE_FILL_COMP)
+                .bindings(&[
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
+                ])
+                .push_constants::<FrameParams>()
+                .build(ctx)?;
+        Ok(TileFillPass { pipeline })
+    }
+
+    /// `cursors` must be zeroed; `entries` holds the band's lists.
+    pub fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        params: &FrameParams,
+        fragments: &Buffer,
+        offsets: &Buffer,
+        cursors: &Buffer,
+        entries: &Buffer,
+    ) -> GpuResult<()> {
+        rec.dispatch(
+            &self.pipeline,
+            &[
+                Binding::Buffer(fragments),
+                Binding::Buffer(offsets),
+                Binding::Buffer(cursors),
+                Binding::Buffer(entries),
+            ],
+            params,
+            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+        )
+    }
+}
+
+/// Workgroup grid with one workgroup per tile, folded into two dimensions past the per-axis
+/// dispatch limit (the shaders unfold it and skip the excess).
+pub(super) fn per_tile_groups(tiles: u32) -> [u32; 3] {
+    const AXIS: u32 = 65_535;
+    [tiles.clamp(1, AXIS), tiles.div_ceil(AXIS).max(1), 1]
+}

@@ -1,0 +1,147 @@
+//! CPU implementations of each splat step, written from the specification in
+//! src/render/splat/ (not from the shaders), to check the GPU passes one by one.
+#![allow(dead_code)]
+
+use ocular::render::splat::{Fragment, MergeSettings};
+
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub tile: u32,
+    pub dioptre_min: f32,
+    pub dioptre_step: f32,
+    pub max_radius: u32,
+}
+
+pub fn fragments(
+    frame: &Frame,
+    color: &[[f32; 4]],
+    depth: &[f32],
+    radii: &[[f32; 3]],
+) -> Vec<Fragment> {
+    let last = (radii.len() - 1) as f32;
+    (0..frame.width * frame.height)
+        .map(|i| {
+            let d = depth[i as usize];
+            let dioptre = if d > 0.0 && d.is_finite() {
+                1.0 / d
+            } else {
+                0.0
+            };
+            let index = ((dioptre - frame.dioptre_min) / frame.dioptre_step).clamp(0.0, last);
+            let i0 = index.floor() as usize;
+            let i1 = (i0 + 1).min(radii.len() - 1);
+            let t = index - i0 as f32;
+            let radius = [0, 1, 2].map(|c| {
+                (radii[i0][c] * (1.0 - t) + radii[i1][c] * t).min(frame.max_radius as f32)
+            });
+            let c = color[i as usize];
+            Fragment {
+                color: [c[0], c[1], c[2]],
+                depth: if d > 0.0 { d } else { 3.0e38 },
+                radius,
+                index,
+                center: [
+                    (i % frame.width) as f32 + 0.5,
+                    (i / frame.width) as f32 + 0.5,
+                ],
+                size: 1,
+                pad: 0,
+            }
+        })
+        .collect()
+}
+
+/// One merge level (block `size` 2 or 4) following the rules in merge.comp's header.
+pub fn merge_level(frame: &Frame, fragments: &mut [Fragment], settings: &MergeSettings, size: u32) {
+    let child = size / 2;
+    let w = frame.width;
+    for by in 0..frame.height / size {
+        for bx in 0..w / size {
+            let o = (by * size) * w + bx * size;
+            let ids = [o, o + child, o + child * w, o + child * w + child].map(|i| i as usize);
+            let f: Vec<Fragment> = ids.iter().map(|&i| fragments[i]).collect();
+            if f.iter().any(|x| x.size != child) {
+                continue;
+            }
+            let r_min = f
+                .iter()
+                .flat_map(|x| x.radius)
+                .fold(f32::INFINITY, f32::min);
+            if r_min < settings.min_radius_px {
+                continue;
+            }
+            let mut ok = true;
+            let mut spread = 0.0f32;
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    let dc = (0..3)
+                        .map(|c| (f[a].color[c] - f[b].color[c]).abs())
+                        .fold(0.0, f32::max);
+                    if dc >= settings.color_tolerance * r_min {
+                        ok = false;
+                    }
+                    spread += (f[a].index - f[b].index).abs() * frame.dioptre_step;
+                }
+            }
+            if !ok || spread >= 6.0 * settings.dioptre_tolerance * r_min {
+                continue;
+            }
+            let mut m = f[0];
+            m.color = [0, 1, 2].map(|c| 0.25 * f.iter().map(|x| x.color[c]).sum::<f32>());
+            m.depth = f.iter().map(|x| x.depth).fold(f32::INFINITY, f32::min);
+            m.index = 0.25 * f.iter().map(|x| x.index).sum::<f32>();
+            // Second-moment match of the s×s block: R'² = R² + (s² − c²)/3.
+            let grow = (size * size - child * child) as f32 / 3.0;
+            m.radius = [0, 1, 2].map(|c| {
+                let r = f.iter().map(|x| x.radius[c]).fold(0.0, f32::max);
+                (r * r + grow).sqrt().min(frame.max_radius as f32)
+            });
+            m.center = [
+                (bx * size) as f32 + 0.5 * size as f32,
+                (by * size) as f32 + 0.5 * size as f32,
+            ];
+            m.size = size;
+            fragments[ids[0]] = m;
+            for &i in &ids[1..] {
+                fragments[i].size = 0;
+            }
+        }
+    }
+}
+
+/// Inclusive pixel rectangle a fragment's kernel can reach (square support).
+pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
+    let r = f.radius.iter().fold(0.0f32, |a, &b| a.max(b)).ceil();
+    let reach = if f.size > 1 { r + 0.5 } else { r };
+    let x0 = ((f.center[0] - 0.5 - reach).ceil() as i64).max(0);
+    let y0 = ((f.center[1] - 0.5 - reach).ceil() as i64).max(0);
+    let x1 = ((f.center[0] - 0.5 + reach).floor() as i64).min(frame.width as i64 - 1);
+    let y1 = ((f.center[1] - 0.5 + reach).floor() as i64).min(frame.height as i64 - 1);
+    (x0 <= x1 && y0 <= y1).then_some([x0, y0, x1, y1])
+}
+
+/// Per tile, the sorted (depth bits, fragment index) list.
+pub fn tile_lists(frame: &Frame, fragments: &[Fragment]) -> Vec<Vec<[u32; 2]>> {
+    let t = frame.tile as i64;
+    let tiles_x = frame.width.div_ceil(frame.tile) as usize;
+    let tiles_y = frame.height.div_ceil(frame.tile) as usize;
+    let mut lists = vec![Vec::new(); tiles_x * tiles_y];
+    for (i, f) in fragments.iter().enumerate() {
+        if f.size == 0 {
+            continue;
+        }
+        if let Some([x0, y0, x1, y1]) = reach_rect(frame, f) {
+            for ty in y0 / t..=y1 / t {
+                for tx in x0 / t..=x1 / t {
+                    lists[ty as usize * tiles_x + tx as usize]
+                        .push([f.depth.max(0.0).to_bits(), i as u32]);
+                }
+            }
+        }
+    }
+    for list in &mut lists {
+        list.sort_unstable();
+    }
+    lists
+}

@@ -1,0 +1,634 @@
+//! The tiled PSF-splatting runtime on lavapipe, against CPU references: the PSF texture against
+//! the CPU blend of the kernel grid, each pass against a CPU implementation of its step, and
+//! whole frames against the ground-truth renderer.
+
+mod common;
+
+use common::splat_cpu;
+use common::synthetic::{ExactSynthetic, SyntheticEye};
+use ocular::gpu::texture_probe::TextureProbe;
+use ocular::gpu::Context;
+use ocular::psf::kernels::{kernel_side, DioptreAxis, KernelGrid};
+use ocular::render::reference;
+use ocular::render::splat::{
+    FrameInput, MergeSettings, PsfTextureFormat, SplatOutput, SplatSettings, Splatter, ViewState,
+};
+
+const NO_MERGE: MergeSettings = MergeSettings {
+    levels: 0,
+    min_radius_px: 5.0,
+    color_tolerance: 0.1,
+    dioptre_tolerance: 0.01,
+};
+
+struct Scene {
+    width: u32,
+    height: u32,
+    color: Vec<[f32; 4]>,
+    depth: Vec<f32>,
+}
+
+impl Scene {
+    fn new(width: u32, height: u32, f: impl Fn(u32, u32) -> ([f32; 3], f32)) -> Scene {
+        let mut color = Vec::new();
+        let mut depth = Vec::new();
+        for y in 0..height {
+            for x in 0..width {
+                let (c, d) = f(x, y);
+                color.push([c[0], c[1], c[2], 1.0]);
+                depth.push(d);
+            }
+        }
+        Scene {
+            width,
+            height,
+            color,
+            depth,
+        }
+    }
+
+    fn input(&self) -> FrameInput<'_> {
+        FrameInput {
+            width: self.width,
+            height: self.height,
+            color: &self.color,
+            depth_m: &self.depth,
+        }
+    }
+}
+
+fn axis_for(eye: &SyntheticEye, min_d: f64, max_d: f64, count: usize) -> (DioptreAxis, u32) {
+    let axis = DioptreAxis::spanning(min_d, max_d, count);
+    let max_radius = (0..count)
+        .flat_map(|o| (0..3).map(move |c| (o, c)))
+        .map(|(o, c)| eye.radius_px(c, axis.value_d(o), 4.0))
+        .fold(0.0f64, f64::max)
+        .ceil() as u32;
+    (axis, max_radius)
+}
+
+fn splat(
+    ctx: &Context,
+    grid: &KernelGrid,
+    settings: SplatSettings,
+    scene: &Scene,
+    keep: bool,
+) -> SplatOutput {
+    let mut splatter = Splatter::new(ctx, grid.clone(), settings).unwrap();
+    splatter
+        .render(
+            &scene.input(),
+            ViewState {
+                pupil_mm: 4.0,
+                focus_d: grid.focus_d[0],
+            },
+            keep,
+        )
+        .unwrap()
+}
+
+fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let mse: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| {
+            (0..3)
+                .map(|c| (f64::from(p[c]) - f64::from(q[c])).powi(2))
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+        / (3 * a.len()) as f64;
+    if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        10.0 * (1.0 / mse).log10()
+    }
+}
+
+fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
+        .fold(0.0, f32::max)
+}
+
+/// Smooth, textured colour in [0.05, 0.95].
+fn texture(x: u32, y: u32, seed: f32) -> [f32; 3] {
+    let (x, y) = (x as f32, y as f32);
+    [
+        0.5 + 0.45 * (0.21 * x + seed).sin(),
+        0.5 + 0.45 * (0.17 * y + 0.5 * seed).cos(),
+        0.5 + 0.45 * ((x + y) * 0.09 + 2.0 * seed).sin(),
+    ]
+}
+
+#[test]
+fn psf_texture_matches_cpu_blend_of_four_grid_states() {
+    let ctx = common::gpu();
+    let objects = DioptreAxis::spanning(0.0, 2.0, 5);
+    let max_radius = 6;
+    let mut eye = SyntheticEye::new(0.5, 2.5);
+    eye.pupil_scale = true;
+    let mut sets = Vec::new();
+    for pupil in [2.0, 6.0] {
+        for focus in [0.5, 1.5] {
+            eye.focus_d = [focus - 0.1, focus, focus + 0.2];
+            let mut set = eye.kernel_set(objects, max_radius, pupil);
+            set.focus_d = focus;
+            sets.push(set);
+        }
+    }
+    let grid = KernelGrid {
+        pupils_mm: vec![2.0, 6.0],
+        focus_d: vec![0.5, 1.5],
+        wavelengths_nm: [612.0, 549.0, 464.0],
+        objects,
+        max_radius_px: max_radius,
+        fov_y_deg: 60.0,
+        height_px: 90,
+        sets,
+    };
+    let view = ViewState {
+        pupil_mm: 3.0,
+        focus_d: 0.75,
+    };
+    assert_eq!(grid.blend(view.pupil_mm, view.focus_d).corners.len(), 4);
+    let expected = grid.blended_set(view.pupil_mm, view.focus_d);
+    let scene = Scene::new(16, 16, |_, _| ([0.5; 3], 2.0));
+    for (format, tolerance) in [
+        (PsfTextureFormat::Rgba32Float, 1e-5),
+        (PsfTextureFormat::Rgba16Float, 2e-3),
+    ] {
+        let settings = SplatSettings {
+            texture_format: format,
+            merge: NO_MERGE,
+            ..SplatSettings::default()
+        };
+        let mut splatter = Splatter::new(&ctx, grid.clone(), settings).unwrap();
+        splatter.render(&scene.input(), view, false).unwrap();
+        let (image, sampler) = splatter.psf_texture();
+        let [w, h, d] = image.extent();
+        let mut points = Vec::new();
+        for z in 0..d {
+            for y in 0..h {
+                for x in 0..w {
+                    points.push([x as f32 + 0.5, y as f32 + 0.5, z as f32 + 0.5]);
+                }
+            }
+        }
+        let probe = TextureProbe::new(&ctx).unwrap();
+        let samples = probe.sample(&ctx, image, sampler, &points).unwrap();
+        let rmax = max_radius as i64;
+        let mut worst = 0.0f32;
+        for (p, s) in points.iter().zip(&samples) {
+            let (x, y, z) = (p[0] as i64, p[1] as i64, p[2] as usize);
+            let (r, o) = ((z / objects.count) as u32, z % objects.count);
+            let (dx, dy) = (x - rmax, y - rmax);
+            let want = if dx.abs() <= r as i64 && dy.abs() <= r as i64 {
+                let side = kernel_side(r);
+                let texel = expected.kernel(r, o)
+                    [(dy + r as i64) as usize * side + (dx + r as i64) as usize];
+                texel.map(|v| v * (side * side) as f32)
+            } else {
+                [0.0; 3]
+            };
+            for c in 0..3 {
+                worst = worst.max((want[c] - s[c]).abs() / want[c].abs().max(1.0));
+            }
+        }
+        eprintln!("{format:?}: worst relative texel error {worst:.2e}");
+        assert!(worst < tolerance, "{format:?}: {worst}");
+        drop((splatter, probe));
+    }
+    common::finish(ctx);
+}
+
+#[test]
+fn blurred_point_over_sharp_background_renders_as_its_kernel() {
+    let ctx = common::gpu();
+    let mut eye = SyntheticEye::new(0.5, 3.0);
+    eye.focus_d = [0.5; 3];
+    let (objects, max_radius) = axis_for(&eye, 0.5, 4.5, 9);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let (px, py, point_depth) = (40u32, 30u32, 1.0 / 2.8f32);
+    let white = [1.0, 0.8, 0.6];
+    // The background is in focus (0.5 D): its kernel is a single texel of weight 1.
+    let scene = Scene::new(80, 60, |x, y| {
+        if (x, y) == (px, py) {
+            (white, point_depth)
+        } else {
+            ([0.0; 3], 2.0)
+        }
+    });
+    let out = splat(
+        &ctx,
+        &grid,
+        SplatSettings {
+            merge: NO_MERGE,
+            ..SplatSettings::default()
+        },
+        &scene,
+        false,
+    );
+    let set = &grid.sets[0];
+    let dioptre = 1.0 / f64::from(point_depth);
+    let index = objects.index_of(dioptre);
+    let (o0, t) = (index.floor() as usize, (index - index.floor()) as f32);
+    let o1 = (o0 + 1).min(objects.count - 1);
+    let mut worst = 0.0f32;
+    let mut peak = 0.0f32;
+    for c in 0..3 {
+        let radius = set.radius_px[o0][c] * (1.0 - t) + set.radius_px[o1][c] * t;
+        let (r0, r1, tr) = (
+            radius.floor() as u32,
+            radius.ceil() as u32,
+            radius - radius.floor(),
+        );
+        let weight_at = |r: u32, dx: i64, dy: i64| -> f32 {
+            if dx.abs() > r as i64 || dy.abs() > r as i64 {
+                return 0.0;
+            }
+            let side = kernel_side(r);
+            let i = (dy + r as i64) as usize * side + (dx + r as i64) as usize;
+            set.kernel(r, o0)[i][c] * (1.0 - t) + set.kernel(r, o1)[i][c] * t
+        };
+        for y in 0..60i64 {
+            for x in 0..80i64 {
+                let (dx, dy) = (x - px as i64, y - py as i64);
+                let w = weight_at(r0, dx, dy) * (1.0 - tr) + weight_at(r1, dx, dy) * tr;
+                // At its own pixel nothing lies behind the point, so C / A returns its colour.
+                let want = if (dx, dy) == (0, 0) {
+                    white[c]
+                } else {
+                    w * white[c]
+                };
+                let got = out.color[(y * 80 + x) as usize][c];
+                peak = peak.max(w * white[c]);
+                worst = worst.max((got - want).abs());
+            }
+        }
+    }
+    eprintln!("point kernel: worst |splat − kernel| = {worst:.2e} (kernel peak {peak:.3})");
+    assert!(
+        worst < 2e-3 * peak.max(1e-3) + 1e-5,
+        "worst {worst}, peak {peak}"
+    );
+    common::finish(ctx);
+}
+
+#[test]
+fn uniform_plane_renders_uniform_and_conserves_energy() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.2, 4.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let colour = [0.3, 0.55, 0.8];
+    let scene = Scene::new(160, 90, |_, _| (colour, 0.5));
+    for merge in [NO_MERGE, MergeSettings::default()] {
+        let out = splat(
+            &ctx,
+            &grid,
+            SplatSettings {
+                merge,
+                ..SplatSettings::default()
+            },
+            &scene,
+            false,
+        );
+        let worst = out
+            .color
+            .iter()
+            .flat_map(|p| (0..3).map(move |c| (p[c] - colour[c]).abs() / colour[c]))
+            .fold(0.0, f32::max);
+        let energy_in: f64 = scene
+            .color
+            .iter()
+            .map(|p| f64::from(p[0] + p[1] + p[2]))
+            .sum();
+        let energy_out: f64 = out
+            .color
+            .iter()
+            .map(|p| f64::from(p[0] + p[1] + p[2]))
+            .sum();
+        eprintln!(
+            "merge levels {}: worst relative deviation {worst:.2e}, live fragments {}",
+            merge.levels, out.stats.live_fragments
+        );
+        assert!(worst < 1e-3, "{worst}");
+        assert!((energy_out / energy_in - 1.0).abs() < 1e-3);
+    }
+    common::finish(ctx);
+}
+
+fn layered_scene() -> Scene {
+    // Background at 0.4 D, a mid plane at 1.5 D, a near square at 3 D, an infinitely far strip.
+    Scene::new(160, 90, |x, y| {
+        if (70..110).contains(&x) && (20..55).contains(&y) {
+            (texture(x, y, 2.0), 1.0 / 3.0)
+        } else if (20..90).contains(&x) && (35..80).contains(&y) {
+            (texture(x, y, 1.0), 1.0 / 1.5)
+        } else if y < 8 {
+            ([0.9, 0.9, 0.2], f32::INFINITY)
+        } else {
+            (texture(x, y, 0.0), 1.0 / 0.4)
+        }
+    })
+}
+
+#[test]
+fn layered_scene_matches_ground_truth() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.4, 3.0);
+    // 0.125 D steps: the synthetic shapes change quickly with dioptres.
+    let (objects, max_radius) = axis_for(&eye, 0.0, 4.0, 33);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let scene = layered_scene();
+    let truth = reference::render(
+        &scene.input(),
+        &ExactSynthetic {
+            eye: eye.clone(),
+            pupil_mm: 4.0,
+            max_radius,
+        },
+    );
+    for (label, settings) in [
+        ("defaults", SplatSettings::default()),
+        (
+            "no merge",
+            SplatSettings {
+                merge: NO_MERGE,
+                ..SplatSettings::default()
+            },
+        ),
+        (
+            "rgba32f",
+            SplatSettings {
+                texture_format: PsfTextureFormat::Rgba32Float,
+                ..SplatSettings::default()
+            },
+        ),
+    ] {
+        let out = splat(&ctx, &grid, settings, &scene, false);
+        let db = psnr(&out.color, &truth);
+        eprintln!(
+            "layered scene, {label}: PSNR vs ground truth {db:.2} dB, {} list entries",
+            out.stats.list_entries
+        );
+        assert!(db >= 45.0, "{label}: {db:.2} dB");
+    }
+    common::finish(ctx);
+}
+
+#[test]
+fn occlusion_is_ordered_like_the_ground_truth() {
+    let ctx = common::gpu();
+    let mut eye = SyntheticEye::new(1.0, 4.0);
+    eye.focus_d = [1.0; 3];
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let exact = ExactSynthetic {
+        eye: eye.clone(),
+        pupil_mm: 4.0,
+        max_radius,
+    };
+    let (fg, bg) = ([0.9, 0.2, 0.1], [0.1, 0.3, 0.9]);
+    // Sharp foreground (in focus, 1 D) left of x = 80 over a blurred background (3 D... far: 0 D).
+    let sharp_over_blurred = Scene::new(160, 90, |x, _| {
+        if x < 80 {
+            (fg, 1.0)
+        } else {
+            (bg, f32::INFINITY)
+        }
+    });
+    // Blurred foreground (3 D) over a sharp background (1 D).
+    let blurred_over_sharp = Scene::new(
+        160,
+        90,
+        |x, _| if x < 80 { (fg, 1.0 / 3.0) } else { (bg, 1.0) },
+    );
+    for (label, scene) in [
+        ("sharp over blurred", &sharp_over_blurred),
+        ("blurred over sharp", &blurred_over_sharp),
+    ] {
+        let out = splat(
+            &ctx,
+            &grid,
+            SplatSettings {
+                merge: NO_MERGE,
+                ..SplatSettings::default()
+            },
+            scene,
+            false,
+        );
+        let truth = reference::render(&scene.input(), &exact);
+        let db = psnr(&out.color, &truth);
+        eprintln!(
+            "{label}: PSNR vs ground truth {db:.2} dB, max diff {:.2e}",
+            max_abs_diff(&out.color, &truth)
+        );
+        assert!(db >= 45.0, "{label}: {db:.2}");
+        let row = |x: usize| out.color[45 * 160 + x];
+        if label == "sharp over blurred" {
+            // The in-focus foreground occludes everything behind it: its pixels stay exact.
+            for x in 0..80 {
+                assert!(
+                    (0..3).all(|c| (row(x)[c] - fg[c]).abs() < 1e-5),
+                    "x = {x}: {:?}",
+                    row(x)
+                );
+            }
+            // The blurred background does not spill over the sharp foreground but is itself
+            // untouched far from the edge.
+            assert!((0..3).all(|c| (row(159)[c] - bg[c]).abs() < 1e-4));
+        } else {
+            // The blurred foreground spills over the sharp background next to the edge.
+            let spill = row(81);
+            assert!(
+                spill[0] > bg[0] + 0.05,
+                "no foreground light beyond the edge: {spill:?}"
+            );
+            assert!((0..3).all(|c| (row(159)[c] - bg[c]).abs() < 1e-4));
+        }
+    }
+    common::finish(ctx);
+}
+
+#[test]
+fn every_pass_matches_its_cpu_step() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.2, 5.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    // Large smooth regions merge; the textured square and the edges do not.
+    let scene = Scene::new(96, 64, |x, y| {
+        if (40..70).contains(&x) && (10..40).contains(&y) {
+            (texture(x, y, 3.0), 0.4)
+        } else if x < 30 {
+            ([0.2, 0.4, 0.6], 0.5)
+        } else {
+            ([0.7, 0.7, 0.7], 2.0)
+        }
+    });
+    let merge = MergeSettings {
+        levels: 2,
+        ..MergeSettings::default()
+    };
+    let settings = SplatSettings {
+        merge,
+        ..SplatSettings::default()
+    };
+    let out = splat(&ctx, &grid, settings, &scene, true);
+    let gpu = out.intermediates.expect("kept");
+    let frame = splat_cpu::Frame {
+        width: 96,
+        height: 64,
+        tile: 8,
+        dioptre_min: objects.min_d as f32,
+        dioptre_step: objects.step_d as f32,
+        max_radius,
+    };
+    let mut cpu = splat_cpu::fragments(&frame, &scene.color, &scene.depth, &grid.sets[0].radius_px);
+    splat_cpu::merge_level(&frame, &mut cpu, &merge, 2);
+    splat_cpu::merge_level(&frame, &mut cpu, &merge, 4);
+    let merged = cpu.iter().filter(|f| f.size > 1).count();
+    assert!(
+        merged > 20,
+        "the scene should exercise merging ({merged} merged fragments)"
+    );
+    assert!(cpu.iter().any(|f| f.size == 4), "no 4×4 merge happened");
+    for (i, (g, c)) in gpu.fragments.iter().zip(&cpu).enumerate() {
+        assert_eq!(
+            g.size, c.size,
+            "merge decision differs at fragment {i}: {g:?} vs {c:?}"
+        );
+        if c.size == 0 {
+            continue;
+        }
+        assert_eq!(g.center, c.center, "fragment {i}");
+        assert_eq!(g.depth, c.depth, "fragment {i}");
+        for k in 0..3 {
+            assert!(
+                (g.radius[k] - c.radius[k]).abs() < 1e-4,
+                "fragment {i}: {g:?} vs {c:?}"
+            );
+            assert!((g.color[k] - c.color[k]).abs() < 1e-6, "fragment {i}");
+        }
+        assert!((g.index - c.index).abs() < 1e-5, "fragment {i}");
+    }
+    // Use the GPU's fragments from here on, so float ties in radii cannot blur the comparison.
+    let lists = splat_cpu::tile_lists(&frame, &gpu.fragments);
+    let counts: Vec<u32> = lists.iter().map(|l| l.len() as u32).collect();
+    assert_eq!(gpu.counts, counts, "tile counts");
+    let mut running = 0u32;
+    for (t, &count) in counts.iter().enumerate() {
+        assert_eq!(gpu.offsets[t], running, "offset of tile {t}");
+        running += count;
+    }
+    assert_eq!(gpu.offsets[counts.len()], running, "total");
+    for (t, list) in lists.iter().enumerate() {
+        let start = gpu.offsets[t] as usize;
+        assert_eq!(
+            &gpu.entries[start..start + list.len()],
+            &list[..],
+            "sorted list of tile {t}"
+        );
+    }
+    assert_eq!(
+        out.stats.live_fragments,
+        gpu.fragments.iter().filter(|f| f.size > 0).count() as u64
+    );
+    common::finish(ctx);
+}
+
+#[test]
+fn huge_blur_long_lists_and_bands_render_the_same() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.0, 9.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.5, 8);
+    assert!(max_radius >= 30);
+    let grid = eye.grid(objects, max_radius, &[4.0], 48);
+    // Everything strongly blurred: every tile's list holds thousands of fragments, past the
+    // shared-memory sort (2048), so the global-memory sort path runs too.
+    let scene = Scene::new(64, 48, |x, y| {
+        (texture(x, y, 0.7), if x < 32 { 0.3 } else { 0.35 })
+    });
+    let one = splat(
+        &ctx,
+        &grid,
+        SplatSettings {
+            merge: NO_MERGE,
+            ..SplatSettings::default()
+        },
+        &scene,
+        false,
+    );
+    assert_eq!(one.stats.bands, 1);
+    assert!(
+        one.stats.max_entries_per_tile > 2048,
+        "{}",
+        one.stats.max_entries_per_tile
+    );
+    let small = SplatSettings {
+        merge: NO_MERGE,
+        max_list_bytes: one.stats.list_entries * 8 / 3,
+        ..SplatSettings::default()
+    };
+    let banded = splat(&ctx, &grid, small, &scene, false);
+    assert!(banded.stats.bands >= 3, "{} bands", banded.stats.bands);
+    assert_eq!(banded.color, one.color, "bands must not change the image");
+    let truth = reference::render(
+        &scene.input(),
+        &ExactSynthetic {
+            eye,
+            pupil_mm: 4.0,
+            max_radius,
+        },
+    );
+    let db = psnr(&one.color, &truth);
+    eprintln!(
+        "huge blur: {} entries, max {} per tile, {} bands when limited; PSNR {db:.2} dB",
+        one.stats.list_entries, one.stats.max_entries_per_tile, banded.stats.bands
+    );
+    assert!(db >= 45.0, "{db:.2}");
+    common::finish(ctx);
+}
+
+#[test]
+fn tile_sizes_agree_and_frames_are_deterministic() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.4, 3.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 4.0, 17);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let scene = layered_scene();
+    let base = splat(&ctx, &grid, SplatSettings::default(), &scene, false);
+    let again = splat(&ctx, &grid, SplatSettings::default(), &scene, false);
+    assert_eq!(base.color, again.color, "two runs differ");
+    for tile_size in [16, 32] {
+        let other = splat(
+            &ctx,
+            &grid,
+            SplatSettings {
+                tile_size,
+                ..SplatSettings::default()
+            },
+            &scene,
+            false,
+        );
+        assert_eq!(
+            other.color, base.color,
+            "tile size {tile_size} changes the image"
+        );
+    }
+    let err = Splatter::new(
+        &ctx,
+        grid.clone(),
+        SplatSettings {
+            tile_size: 12,
+            ..SplatSettings::default()
+        },
+    )
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("tile size 12"), "{err}");
+    common::finish(ctx);
+}
