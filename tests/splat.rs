@@ -237,7 +237,7 @@ fn blurred_point_over_sharp_background_renders_as_its_kernel() {
     let o1 = (o0 + 1).min(objects.count - 1);
     let mut worst = 0.0f32;
     let mut peak = 0.0f32;
-    for c in 0..3 {
+    for (c, &white_c) in white.iter().enumerate() {
         let radius = set.radius_px[o0][c] * (1.0 - t) + set.radius_px[o1][c] * t;
         let (r0, r1, tr) = (
             radius.floor() as u32,
@@ -263,7 +263,7 @@ fn blurred_point_over_sharp_background_renders_as_its_kernel() {
                     w * white[c]
                 };
                 let got = out.color[(y * 80 + x) as usize][c];
-                peak = peak.max(w * white[c]);
+                peak = peak.max(w * white_c);
                 worst = worst.max((got - want).abs());
             }
         }
