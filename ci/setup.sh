@@ -32,7 +32,7 @@ else
 fi
 
 if ! command -v cargo >/dev/null; then
-    say "cargo not found: install Rust (1.85 or newer) with rustup, then run this again"
+    say "cargo not found: install Rust (1.87 or newer) with rustup, then run this again"
     exit 1
 fi
 

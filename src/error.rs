@@ -12,6 +12,9 @@ pub enum Error {
     File { path: String, message: String },
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// An eye whose parameters are impossible or out of range.
+    #[error(transparent)]
+    Eye(#[from] crate::eye::EyeError),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
@@ -32,7 +35,7 @@ impl Error {
     /// 1 for failures of the machine or the program.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Input(_) | Error::File { .. } => 2,
+            Error::Input(_) | Error::File { .. } | Error::Eye(_) => 2,
             Error::Gpu(GpuError::DeviceNotFound { .. } | GpuError::DeviceUnsuitable { .. }) => 2,
             Error::Gpu(_) => 1,
         }

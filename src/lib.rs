@@ -6,7 +6,9 @@
 
 pub mod cli;
 pub mod error;
+pub mod eye;
 pub mod gpu;
+pub mod optics;
 pub mod psf;
 pub mod render;
 

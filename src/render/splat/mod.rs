@@ -637,13 +637,14 @@ mod tests {
     fn bands_cover_every_row_once_and_respect_capacity() {
         let tiles_x = 3;
         let counts = [5, 5, 5, 1, 1, 1, 9, 0, 0, 2, 2, 2];
-        let bands = plan_bands(&counts, tiles_x, 10).unwrap();
+        // Rows hold 15, 3, 9 and 6 entries.
+        let bands = plan_bands(&counts, tiles_x, 15).unwrap();
         assert_eq!(
             bands
                 .iter()
-                .map(|b| (b.first_tile, b.end_tile))
+                .map(|b| (b.first_tile, b.end_tile, b.first_entry))
                 .collect::<Vec<_>>(),
-            [(0, 3), (3, 6), (6, 9), (9, 12)]
+            [(0, 3, 0), (3, 9, 15), (9, 12, 27)]
         );
         let bands = plan_bands(&counts, tiles_x, 20).unwrap();
         assert_eq!(

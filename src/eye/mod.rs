@@ -1,0 +1,23 @@
+//! The parametric eye (Navarro-based, extended as in Csoba & Kunkli 2021): structure,
+//! exact ray tracing, paraxial optics, accommodation and aberration measurement.
+
+pub mod accommodate;
+pub mod draw;
+pub mod fit;
+pub mod lens;
+pub mod measure;
+pub mod media;
+pub mod model;
+pub mod paraxial;
+pub mod presets;
+pub mod show;
+pub mod surface;
+pub mod system;
+pub mod trace;
+
+pub use accommodate::{accommodate, Accommodation};
+pub use measure::{measure, Measurement, Measurer, Refraction};
+pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens};
+pub use paraxial::{paraxial, Paraxial};
+pub use presets::navarro_accommodated;
+pub use system::OpticalSystem;
