@@ -15,6 +15,12 @@ pub enum Error {
     /// An eye whose parameters are impossible or out of range.
     #[error(transparent)]
     Eye(#[from] crate::eye::EyeError),
+    /// Invalid optics input (coefficients, pupil, wavelength, settings).
+    #[error(transparent)]
+    Optics(#[from] crate::optics::OpticsError),
+    /// A Zernike file or preset that cannot be read or is malformed.
+    #[error(transparent)]
+    Aberrations(#[from] crate::aberrations::AberrationError),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;
@@ -35,7 +41,11 @@ impl Error {
     /// 1 for failures of the machine or the program.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Input(_) | Error::File { .. } | Error::Eye(_) => 2,
+            Error::Input(_)
+            | Error::File { .. }
+            | Error::Eye(_)
+            | Error::Optics(_)
+            | Error::Aberrations(_) => 2,
             Error::Gpu(GpuError::DeviceNotFound { .. } | GpuError::DeviceUnsuitable { .. }) => 2,
             Error::Gpu(_) => 1,
         }

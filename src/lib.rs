@@ -4,6 +4,7 @@
 //! a thin Vulkan layer that knows nothing about eyes; `render` joins them; `cli` holds one file
 //! per subcommand.
 
+pub mod aberrations;
 pub mod cli;
 pub mod error;
 pub mod eye;
