@@ -9,6 +9,7 @@ pub mod cli;
 pub mod error;
 pub mod eye;
 pub mod gpu;
+pub mod metrics;
 pub mod optics;
 pub mod psf;
 pub mod render;

@@ -1,4 +1,5 @@
 //! Rendering: joins the eye's kernels (`psf`) with the GPU layer (`gpu`).
 
 pub mod reference;
+pub mod slices;
 pub mod splat;
