@@ -6,8 +6,9 @@ use ash::vk;
 use super::buffer::Buffer;
 use super::context::Context;
 use super::error::{GpuError, GpuResult, VkContext};
+use super::graphics::{Framebuffer, GraphicsPipeline};
 use super::image::Image;
-use super::pipeline::{Binding, BindingKind, ComputePipeline};
+use super::pipeline::{Binding, BindingKind, ComputePipeline, PipelineParts};
 
 /// Timestamp pairs per submission; more passes than this in one submission are not timed.
 const MAX_TIMED_PASSES: u32 = 64;
@@ -58,6 +59,8 @@ pub struct Recorder<'a> {
     passes: Vec<(String, u32)>,
     /// Buffers that must live until the submission has completed (staging data).
     keep_alive: Vec<Buffer>,
+    /// Name of the pipeline whose render pass is open, if one is.
+    render_pass_open: Option<String>,
 }
 
 impl Context {
@@ -105,6 +108,7 @@ impl Context {
             open_pass: None,
             passes: Vec::new(),
             keep_alive: Vec::new(),
+            render_pass_open: None,
         };
         let result = recorder.record_and_run(record);
         let timings = result.and_then(|()| recorder.read_timings());
@@ -140,6 +144,12 @@ impl<'a> Recorder<'a> {
             unsafe { device.cmd_reset_query_pool(self.cmd, pool, 0, 2 * MAX_TIMED_PASSES) };
         }
         record(self)?;
+        if let Some(name) = self.render_pass_open.take() {
+            return Err(GpuError::Usage {
+                pass: name,
+                message: "render pass begun but never ended".into(),
+            });
+        }
         if self.open_pass.is_some() {
             self.end_pass();
         }
@@ -394,7 +404,8 @@ impl<'a> Recorder<'a> {
         self.barrier();
     }
 
-    pub(crate) fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+    /// Copies the whole image into `dst`, tightly packed (row-major x, then y, then z).
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(src.subresource_layers())
             .image_extent(src.vk_extent())];
@@ -427,7 +438,10 @@ impl<'a> Recorder<'a> {
         self.barrier();
     }
 
-    fn allocate_set(&mut self, pipeline: &ComputePipeline) -> GpuResult<vk::DescriptorSet> {
+    fn allocate_set(
+        &mut self,
+        set_layout: vk::DescriptorSetLayout,
+    ) -> GpuResult<vk::DescriptorSet> {
         if self.sets_left_in_pool == 0 {
             let sizes = [
                 vk::DescriptorPoolSize {
@@ -456,7 +470,7 @@ impl<'a> Recorder<'a> {
             self.descriptor_pools.push(pool);
             self.sets_left_in_pool = SETS_PER_POOL;
         }
-        let layouts = [pipeline.set_layout];
+        let layouts = [set_layout];
         let info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(*self.descriptor_pools.last().expect("pool just ensured"))
             .set_layouts(&layouts);
@@ -477,11 +491,21 @@ impl<'a> Recorder<'a> {
         push_constants: &P,
         groups: [u32; 3],
     ) -> GpuResult<()> {
-        self.bind(pipeline, bindings, bytemuck::bytes_of(push_constants))?;
+        if let Some(open) = &self.render_pass_open {
+            return Err(GpuError::Usage {
+                pass: pipeline.name.clone(),
+                message: format!("dispatch inside the render pass of \"{open}\""),
+            });
+        }
+        self.bind(
+            &pipeline.parts(),
+            bindings,
+            bytemuck::bytes_of(push_constants),
+        )?;
         let max = self.ctx.limits().max_compute_work_group_count;
         if groups.iter().zip(max.iter()).any(|(g, m)| g > m) {
             return Err(GpuError::Usage {
-                pass: pipeline.name.clone(),
+                pass: pipeline.name.to_string(),
                 message: format!(
                     "dispatch of {groups:?} workgroups exceeds the device limit {max:?}"
                 ),
@@ -508,7 +532,11 @@ impl<'a> Recorder<'a> {
         args: &Buffer,
         offset: u64,
     ) -> GpuResult<()> {
-        self.bind(pipeline, bindings, bytemuck::bytes_of(push_constants))?;
+        self.bind(
+            &pipeline.parts(),
+            bindings,
+            bytemuck::bytes_of(push_constants),
+        )?;
         // SAFETY: recording; the args buffer has INDIRECT usage and holds 12 bytes at offset.
         unsafe {
             self.device()
@@ -518,14 +546,14 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
-    fn bind(
+    pub(crate) fn bind(
         &mut self,
-        pipeline: &ComputePipeline,
+        pipeline: &PipelineParts<'_>,
         bindings: &[Binding<'_>],
         push: &[u8],
     ) -> GpuResult<()> {
         let usage = |message: String| GpuError::Usage {
-            pass: pipeline.name.clone(),
+            pass: pipeline.name.to_string(),
             message,
         };
         if bindings.len() != pipeline.kinds.len() {
@@ -542,13 +570,17 @@ impl<'a> Recorder<'a> {
                 pipeline.push_constant_bytes
             )));
         }
-        for (i, (binding, kind)) in bindings.iter().zip(&pipeline.kinds).enumerate() {
+        for (i, (binding, kind)) in bindings.iter().zip(pipeline.kinds).enumerate() {
             if !binding.matches(*kind) {
                 return Err(usage(format!("binding {i} must be a {kind:?}")));
             }
         }
         let max_range = u64::from(self.ctx.limits().max_storage_buffer_range);
-        let set = self.allocate_set(pipeline)?;
+        let set = if pipeline.kinds.is_empty() {
+            None
+        } else {
+            Some(self.allocate_set(pipeline.set_layout)?)
+        };
         let mut buffer_infos = Vec::with_capacity(bindings.len());
         let mut image_infos = Vec::with_capacity(bindings.len());
         for (i, binding) in bindings.iter().enumerate() {
@@ -607,7 +639,7 @@ impl<'a> Recorder<'a> {
         for (i, info) in &buffer_infos {
             writes.push(
                 vk::WriteDescriptorSet::default()
-                    .dst_set(set)
+                    .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
                     .descriptor_type(pipeline.kinds[*i].descriptor_type())
                     .buffer_info(std::slice::from_ref(info)),
@@ -616,7 +648,7 @@ impl<'a> Recorder<'a> {
         for (i, info) in &image_infos {
             writes.push(
                 vk::WriteDescriptorSet::default()
-                    .dst_set(set)
+                    .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
                     .descriptor_type(pipeline.kinds[*i].descriptor_type())
                     .image_info(std::slice::from_ref(info)),
@@ -626,27 +658,206 @@ impl<'a> Recorder<'a> {
         // SAFETY: the set is freshly allocated for this layout; infos outlive the call; the
         // command buffer is recording.
         unsafe {
-            device.update_descriptor_sets(&writes, &[]);
-            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
-            device.cmd_bind_descriptor_sets(
-                self.cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                pipeline.layout,
-                0,
-                &[set],
-                &[],
-            );
-            if !push.is_empty() {
-                device.cmd_push_constants(
+            device.cmd_bind_pipeline(self.cmd, pipeline.bind_point, pipeline.pipeline);
+            if let Some(set) = set {
+                device.update_descriptor_sets(&writes, &[]);
+                device.cmd_bind_descriptor_sets(
                     self.cmd,
+                    pipeline.bind_point,
                     pipeline.layout,
-                    vk::ShaderStageFlags::COMPUTE,
                     0,
-                    push,
+                    &[set],
+                    &[],
                 );
+            }
+            if !push.is_empty() {
+                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.stages, 0, push);
             }
         }
         Ok(())
+    }
+
+    /// Begins `pipeline`'s render pass on `framebuffer`, clearing colour target i to
+    /// `clear_colors[i]` and depth to `clear_depth`, sets the viewport to the whole framebuffer
+    /// and binds the pipeline. Draws follow; `end_render_pass` closes it.
+    pub fn begin_render_pass(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        framebuffer: &Framebuffer,
+        clear_colors: &[[f32; 4]],
+        clear_depth: f32,
+    ) -> GpuResult<()> {
+        let parts = pipeline.render_pass_parts();
+        let usage = |message: String| GpuError::Usage {
+            pass: pipeline.name().to_string(),
+            message,
+        };
+        if let Some(open) = &self.render_pass_open {
+            return Err(usage(format!("render pass of \"{open}\" is still open")));
+        }
+        if clear_colors.len() != parts.color_count {
+            return Err(usage(format!(
+                "{} clear colours given, the pipeline has {} colour targets",
+                clear_colors.len(),
+                parts.color_count
+            )));
+        }
+        let expected = parts.color_count + parts.resolve_count + usize::from(parts.has_depth);
+        if framebuffer.attachment_count() != expected {
+            return Err(usage("framebuffer was made for another pipeline".into()));
+        }
+        let mut clears: Vec<vk::ClearValue> = clear_colors
+            .iter()
+            .map(|&c| vk::ClearValue {
+                color: vk::ClearColorValue { float32: c },
+            })
+            .collect();
+        // Resolve targets are not cleared; their entries are placeholders.
+        clears.extend((0..parts.resolve_count).map(|_| vk::ClearValue::default()));
+        if parts.has_depth {
+            clears.push(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: clear_depth,
+                    stencil: 0,
+                },
+            });
+        }
+        let area = vk::Rect2D {
+            offset: vk::Offset2D { x: 0, y: 0 },
+            extent: vk::Extent2D {
+                width: framebuffer.width(),
+                height: framebuffer.height(),
+            },
+        };
+        let info = vk::RenderPassBeginInfo::default()
+            .render_pass(parts.render_pass)
+            .framebuffer(framebuffer.raw())
+            .render_area(area)
+            .clear_values(&clears);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: framebuffer.width() as f32,
+            height: framebuffer.height() as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let device = self.device().clone();
+        // SAFETY: recording outside any render pass; the framebuffer matches the render pass
+        // (checked when it was made) and outlives the submission (callers hold it).
+        unsafe {
+            device.cmd_begin_render_pass(self.cmd, &info, vk::SubpassContents::INLINE);
+            device.cmd_bind_pipeline(
+                self.cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                pipeline.parts().pipeline,
+            );
+            device.cmd_set_viewport(self.cmd, 0, &[viewport]);
+            device.cmd_set_scissor(self.cmd, 0, &[area]);
+        }
+        self.render_pass_open = Some(pipeline.name().to_string());
+        Ok(())
+    }
+
+    /// Draws `index_count` indexed triangles (u32 indices from `first_index`) from one
+    /// interleaved vertex buffer, with `bindings` and `push_constants` as for `dispatch`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw_indexed<P: bytemuck::Pod>(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        bindings: &[Binding<'_>],
+        push_constants: &P,
+        vertices: &Buffer,
+        indices: &Buffer,
+        first_index: u32,
+        index_count: u32,
+    ) -> GpuResult<()> {
+        self.check_in_render_pass(pipeline)?;
+        if (u64::from(first_index) + u64::from(index_count)) * 4 > indices.size_bytes() {
+            return Err(GpuError::Usage {
+                pass: pipeline.name().to_string(),
+                message: format!(
+                    "indices {first_index}..{} lie past the end of index buffer \"{}\"",
+                    first_index + index_count,
+                    indices.name()
+                ),
+            });
+        }
+        self.bind(
+            &pipeline.parts(),
+            bindings,
+            bytemuck::bytes_of(push_constants),
+        )?;
+        if index_count == 0 {
+            return Ok(());
+        }
+        // SAFETY: recording inside the pipeline's render pass; buffers have vertex and index
+        // usage and outlive the submission.
+        unsafe {
+            let device = self.device();
+            device.cmd_bind_vertex_buffers(self.cmd, 0, &[vertices.raw()], &[0]);
+            device.cmd_bind_index_buffer(self.cmd, indices.raw(), 0, vk::IndexType::UINT32);
+            device.cmd_draw_indexed(self.cmd, index_count, 1, first_index, 0, 0);
+        }
+        Ok(())
+    }
+
+    /// Draws `vertex_count` vertices as triangles; `vertices` may be `None` for shaders that
+    /// make their own (a full-screen triangle from `gl_VertexIndex`).
+    pub fn draw<P: bytemuck::Pod>(
+        &mut self,
+        pipeline: &GraphicsPipeline,
+        bindings: &[Binding<'_>],
+        push_constants: &P,
+        vertices: Option<&Buffer>,
+        vertex_count: u32,
+    ) -> GpuResult<()> {
+        self.check_in_render_pass(pipeline)?;
+        self.bind(
+            &pipeline.parts(),
+            bindings,
+            bytemuck::bytes_of(push_constants),
+        )?;
+        if vertex_count == 0 {
+            return Ok(());
+        }
+        // SAFETY: recording inside the pipeline's render pass.
+        unsafe {
+            let device = self.device();
+            if let Some(v) = vertices {
+                device.cmd_bind_vertex_buffers(self.cmd, 0, &[v.raw()], &[0]);
+            }
+            device.cmd_draw(self.cmd, vertex_count, 1, 0, 0);
+        }
+        Ok(())
+    }
+
+    /// Ends the open render pass; a barrier follows, so later passes see its results.
+    pub fn end_render_pass(&mut self) -> GpuResult<()> {
+        if self.render_pass_open.take().is_none() {
+            return Err(GpuError::Usage {
+                pass: "end_render_pass".into(),
+                message: "no render pass is open".into(),
+            });
+        }
+        // SAFETY: a render pass begun by begin_render_pass is open on this command buffer.
+        unsafe { self.device().cmd_end_render_pass(self.cmd) };
+        self.barrier();
+        Ok(())
+    }
+
+    fn check_in_render_pass(&self, pipeline: &GraphicsPipeline) -> GpuResult<()> {
+        match &self.render_pass_open {
+            Some(name) if name == pipeline.name() => Ok(()),
+            Some(name) => Err(GpuError::Usage {
+                pass: pipeline.name().to_string(),
+                message: format!("draw inside the render pass of \"{name}\""),
+            }),
+            None => Err(GpuError::Usage {
+                pass: pipeline.name().to_string(),
+                message: "draw outside a render pass (call begin_render_pass first)".into(),
+            }),
+        }
     }
 
     /// The raw command buffer, for passes (such as the rasteriser) that record graphics work

@@ -6,6 +6,7 @@ mod buffer;
 mod commands;
 mod context;
 mod error;
+mod graphics;
 mod image;
 mod pipeline;
 pub mod texture_probe;
@@ -17,6 +18,10 @@ pub use context::{
     ValidationLog,
 };
 pub use error::{GpuError, GpuResult};
+pub use graphics::{
+    CullMode, DepthCompare, Framebuffer, GraphicsPipeline, GraphicsPipelineBuilder,
+    VertexAttribute, VertexFormat,
+};
 pub use image::{Edge, Image, ImageUsage, Sampler, TexelFormat};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, ComputePipelineBuilder};
 
