@@ -7,6 +7,7 @@
 pub mod cli;
 pub mod error;
 pub mod gpu;
+pub mod image_io;
 
 /// SPIR-V of every shader under `glsl/`, compiled by build.rs.
 pub mod shaders {
