@@ -8,6 +8,7 @@ pub mod cli;
 pub mod error;
 pub mod gpu;
 pub mod image_io;
+pub mod render;
 pub mod scene;
 
 /// SPIR-V of every shader under `glsl/`, compiled by build.rs.
