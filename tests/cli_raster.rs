@@ -130,3 +130,55 @@ fn raster_help_explains_units() {
         assert!(text.contains(needle), "missing {needle} in\n{text}");
     }
 }
+
+#[test]
+fn time_option_evaluates_keyframes() {
+    let dir = temp_dir("time");
+    let scene = dir.join("moving.toml");
+    std::fs::write(
+        &scene,
+        r#"
+[camera]
+position = [0.0, 0.0, 0.0]
+far_m = 50.0
+
+[[object]]
+kind = "plane"
+size_m = 100.0
+translate = [0.0, 0.0, -5.0]
+
+[[keyframe]]
+time_s = 0.0
+camera = { position = [0.0, 0.0, 0.0] }
+
+[[keyframe]]
+time_s = 2.0
+camera = { position = [0.0, 0.0, -3.0] }
+"#,
+    )
+    .unwrap();
+    for (time, expected) in [("0", 5.0f32), ("2", 2.0), ("9", 2.0)] {
+        let depth = dir.join(format!("d{time}.exr"));
+        let out = ocular()
+            .args(["raster", "--size", "32x18", "--time", time, "--scene"])
+            .arg(&scene)
+            .arg("--depth-out")
+            .arg(&depth)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let d = ocular::image_io::read_exr_depth(&depth).unwrap();
+        assert!(
+            d.pixels
+                .iter()
+                .all(|&v| (v - expected).abs() < 1e-4 * expected),
+            "t = {time}: {:?}",
+            &d.pixels[..4]
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

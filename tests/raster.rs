@@ -387,3 +387,87 @@ fn graphics_pipeline_checks_its_framebuffers() {
     drop((fb, pipeline, color, single, depth_values, depth, vertices));
     common::finish(ctx);
 }
+
+#[test]
+fn point_lights_fall_off_with_the_square_of_distance() {
+    let ctx = common::gpu();
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    // 400 cd at the eye, plane 2 m away: 100 lux at the centre, 0.5 · 100 / π cd/m².
+    let s = scene(
+        r#"
+[camera]
+position = [0.0, 0.0, 0.0]
+far_m = 100.0
+
+[[light]]
+kind = "point"
+position = [0.0, 0.0, 0.0]
+intensity_cd = 400.0
+
+[[object]]
+kind = "plane"
+size_m = 10.0
+translate = [0.0, 0.0, -2.0]
+color = [0.5, 0.5, 0.5]
+"#,
+    );
+    let frame = raster.render(&ctx, &s.at_time(0.0), 160, 90).unwrap();
+    // The pixel just right of and below the centre: its ray is 0.37° off axis, cos³ ≈ 1.
+    let c = frame.color[45 * 160 + 80];
+    let expected = 0.5 * 100.0 / std::f32::consts::PI;
+    let y = luminance([c[0], c[1], c[2]]);
+    assert!((y - expected).abs() < 2e-3 * expected, "{y} vs {expected}");
+    drop(raster);
+    common::finish(ctx);
+}
+
+#[test]
+fn textures_are_srgb_decoded_and_mapped_across_the_surface() {
+    let dir = std::env::temp_dir().join(format!("ocular-texture-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Left half mid-grey (sRGB 128), right half pure red.
+    let texture = image::RgbaImage::from_fn(4, 1, |x, _| {
+        if x < 2 {
+            image::Rgba([128, 128, 128, 255])
+        } else {
+            image::Rgba([255, 0, 0, 255])
+        }
+    });
+    texture.save(dir.join("halves.png")).unwrap();
+    let text = r#"
+[camera]
+position = [0.0, 0.0, 0.0]
+fov_y_deg = 30.0
+far_m = 100.0
+
+[[light]]
+kind = "ambient"
+illuminance_lux = 314.159265
+
+[[object]]
+kind = "plane"
+size_m = [1.0, 0.5]
+translate = [0.0, 0.0, -2.0]
+color = [1.0, 1.0, 1.0]
+texture = "halves.png"
+"#;
+    let s = Scene::from_toml(text, "textured", &dir).unwrap();
+    let ctx = common::gpu();
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    let frame = raster.render(&ctx, &s.at_time(0.0), 160, 90).unwrap();
+    // The plane spans x = 80 ± 42 pixels; u = 1/4 and 3/4 lie at x ≈ 59 and 101.
+    let grey = frame.color[45 * 160 + 59];
+    let red = frame.color[45 * 160 + 101];
+    // Luminance = texel (linear) · 1 · 314.16 / π = 100 · texel.
+    let grey_linear = ((128.0f32 / 255.0 + 0.055) / 1.055).powf(2.4);
+    for k in 0..3 {
+        assert!((grey[k] - 100.0 * grey_linear).abs() < 0.1, "{grey:?}");
+    }
+    assert!(
+        (red[0] - 100.0).abs() < 0.1 && red[1] < 0.01 && red[2] < 0.01,
+        "{red:?}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+    drop(raster);
+    common::finish(ctx);
+}
