@@ -9,6 +9,7 @@ mod error;
 mod graphics;
 mod image;
 mod pipeline;
+mod render_pass;
 pub mod texture_probe;
 
 pub use buffer::{Buffer, Residency};

@@ -13,6 +13,7 @@ mod animation;
 mod camera;
 pub mod mesh;
 pub mod obj;
+mod objects;
 pub mod optotype;
 mod spec;
 
