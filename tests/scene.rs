@@ -102,6 +102,10 @@ fn malformed_obj_and_mtl_name_file_and_line() {
         "{message}"
     );
 
+    // The last line, without a trailing newline.
+    let (_, message) = file_error(obj::load(&data("bad_last_line.obj")));
+    assert!(message.contains("line 3"), "{message}");
+
     let (path, message) = file_error(obj::load(&data("missing_mtl.obj")));
     assert!(path.ends_with("missing_mtl.obj"), "{path}");
     assert!(

@@ -61,7 +61,8 @@ impl BufRead for LineCounter<'_> {
 
     fn consume(&mut self, amount: usize) {
         let consumed = &self.data[self.pos..self.pos + amount];
-        if consumed.last() == Some(&b'\n') || self.pos + amount == self.data.len() {
+        // A line ends at its newline, or at the end of the text without one.
+        if consumed.last() == Some(&b'\n') || (amount > 0 && self.pos + amount == self.data.len()) {
             self.lines_done.set(self.lines_done.get() + 1);
         }
         self.pos += amount;
