@@ -471,3 +471,28 @@ texture = "halves.png"
     drop(raster);
     common::finish(ctx);
 }
+
+#[test]
+fn empty_scene_is_background_at_far_and_sizes_can_change() {
+    let ctx = common::gpu();
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    let s = scene(
+        r#"
+[camera]
+position = [0.0, 0.0, 0.0]
+far_m = 30.0
+
+[background]
+color = [0.5, 1.0, 2.0]
+"#,
+    );
+    for (w, h) in [(160, 90), (64, 48), (1, 1)] {
+        let frame = raster.render(&ctx, &s.at_time(0.0), w, h).unwrap();
+        assert_eq!(frame.color.len(), (w * h) as usize);
+        assert!(frame.color.iter().all(|c| *c == [0.5, 1.0, 2.0, 1.0]));
+        assert!(frame.depth_m.iter().all(|&d| d == 30.0));
+    }
+    assert!(raster.render(&ctx, &s.at_time(0.0), 0, 10).is_err());
+    drop(raster);
+    common::finish(ctx);
+}
