@@ -269,7 +269,20 @@ pub(super) fn add_object(
                 ));
             };
             let path = ctx.resolve(file);
-            let loaded = obj::load(&path)?;
+            let loaded = obj::load(&path).map_err(|e| match e {
+                // Say where a missing model was asked for; other errors point into the OBJ.
+                Error::File { path, message } if message.ends_with("not found") => {
+                    let (line, _) = line_col(ctx.text, span.start);
+                    Error::File {
+                        path,
+                        message: format!(
+                            "{message} (file = \"{file}\" in {} line {line})",
+                            ctx.origin.label
+                        ),
+                    }
+                }
+                e => e,
+            })?;
             for part in loaded {
                 let albedo = match (o.colors.unwrap_or_default(), o.color) {
                     (_, Some(c)) => c,
