@@ -190,7 +190,9 @@ fn malformed_scene_files_name_file_line_and_what_is_allowed() {
 
     let (path, message) = file_error(Scene::from_file(&data("missing_obj_scene.toml")));
     assert!(
-        path.ends_with("no_such_model.obj") && message.contains("not found"),
+        path.ends_with("no_such_model.obj")
+            && message.contains("not found")
+            && message.contains("missing_obj_scene.toml line 4"),
         "{message}"
     );
 
