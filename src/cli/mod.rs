@@ -6,6 +6,7 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod devices;
+mod raster;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -31,6 +32,8 @@ pub struct Cli {
 pub enum Command {
     /// List the Vulkan devices and mark the one ocular would use.
     Devices(devices::DevicesArgs),
+    /// Rasterise a scene to linear HDR colour and metric depth (EXR), plus an optional PNG.
+    Raster(raster::RasterArgs),
 }
 
 impl Cli {
@@ -45,5 +48,6 @@ impl Cli {
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Devices(args) => devices::run(&cli, args),
+        Command::Raster(args) => raster::run(&cli, args),
     }
 }
