@@ -144,7 +144,7 @@ fn file_error(path: &Path, message: impl std::fmt::Display) -> Error {
 
 /// Writes a file through `write` into `NAME.tmp-PID` next to `path`, syncs it and renames it
 /// into place; on any failure the temporary file is removed and `path` is untouched.
-fn write_atomic<F>(path: &Path, write: F) -> Result<()>
+pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
 where
     F: FnOnce(&mut BufWriter<std::fs::File>) -> std::result::Result<(), String>,
 {
@@ -177,6 +177,14 @@ where
         }
     }
     Ok(())
+}
+
+/// Writes `text` to `path` atomically (see [`write_atomic`]).
+pub fn write_text_atomic(path: impl AsRef<Path>, text: &str) -> Result<()> {
+    write_atomic(path.as_ref(), |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| format!("cannot write: {e}"))
+    })
 }
 
 fn check_size(path: &Path, width: u32, height: u32, len: usize) -> Result<()> {

@@ -6,6 +6,7 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod devices;
+mod psf;
 mod raster;
 
 #[derive(Debug, Parser)]
@@ -32,6 +33,8 @@ pub struct Cli {
 pub enum Command {
     /// List the Vulkan devices and mark the one ocular would use.
     Devices(devices::DevicesArgs),
+    /// Compute one point-spread function from Zernike coefficients (EXR + JSON sidecar).
+    Psf(psf::PsfArgs),
     /// Rasterise a scene to linear HDR colour and metric depth (EXR), plus an optional PNG.
     Raster(raster::RasterArgs),
 }
@@ -49,5 +52,6 @@ pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Devices(args) => devices::run(&cli, args),
         Command::Raster(args) => raster::run(&cli, args),
+        Command::Psf(args) => psf::run(args),
     }
 }
