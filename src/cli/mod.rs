@@ -6,6 +6,7 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod devices;
+pub mod kernels;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -31,6 +32,8 @@ pub struct Cli {
 pub enum Command {
     /// List the Vulkan devices and mark the one ocular would use.
     Devices(devices::DevicesArgs),
+    /// Precompute an eye's PSF kernel grid (cached), with an optional contact sheet and plot.
+    Kernels(Box<kernels::KernelsArgs>),
 }
 
 impl Cli {
@@ -45,5 +48,6 @@ impl Cli {
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Devices(args) => devices::run(&cli, args),
+        Command::Kernels(args) => kernels::run(args),
     }
 }

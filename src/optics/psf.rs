@@ -26,7 +26,7 @@
 //! exact translation of the field, so it is applied by shifting the evaluation grid (or dropped
 //! with `include_tilt = false`); piston is a global phase.
 
-use super::beta::{beta_from_alpha, StilesCrawford};
+use super::beta::{beta_from_alpha, BetaExpansion, StilesCrawford};
 use super::enz::MAX_ABS_F;
 use super::field::{Block8, FieldTable, LagrangeRule, RadialField};
 use super::quadrature::fejer1_01;
@@ -522,12 +522,39 @@ pub fn compute_psf(req: &PsfRequest) -> Result<Psf, OpticsError> {
         req.beta_tolerance,
         req.max_degree,
     );
+    let seconds_beta = t0.elapsed().as_secs_f64();
+    let mut psf = psf_from_expansion(req, &be, split.f, split.tilt_shift)?;
+    psf.seconds_beta = seconds_beta;
+    Ok(psf)
+}
+
+/// The PSF of an already expanded pupil at total defocus `f` (sign kept), shifted by
+/// `tilt_shift` (λ/NA). Only the grid and numerical fields of `req` are used (its coefficients
+/// are ignored): callers that image one pupil at many defocus values expand β once and call
+/// this per f, since β does not depend on f.
+pub fn psf_from_expansion(
+    req: &PsfRequest,
+    be: &BetaExpansion,
+    f: f64,
+    tilt_shift: (f64, f64),
+) -> Result<Psf, OpticsError> {
+    let grid_only = PsfRequest {
+        coefficients_um: Vec::new(),
+        ..req.clone()
+    };
+    validate(&grid_only)?;
+    check_range(
+        "total defocus f",
+        f,
+        -MAX_ABS_F,
+        MAX_ABS_F,
+        "|f| <= 5000 (requested f plus 4*sqrt(3)*pi*c(2,0)/lambda)",
+    )?;
     let t1 = Instant::now();
     let n = req.size;
-    let rf = RadialField::new(&be.beta, be.degree, split.f);
+    let rf = RadialField::new(&be.beta, be.degree, f);
     let t1b = Instant::now();
-    let (intensity, radial_step, radial_taps, radial_nodes, t2) =
-        synthesize(&rf, req, split.tilt_shift);
+    let (intensity, radial_step, radial_taps, radial_nodes, t2) = synthesize(&rf, req, tilt_shift);
     let t3 = Instant::now();
     let peak = intensity.iter().cloned().fold(0.0, f64::max);
     let sum: f64 = intensity.iter().sum();
@@ -538,8 +565,8 @@ pub fn compute_psf(req: &PsfRequest) -> Result<Psf, OpticsError> {
         size: n,
         pitch_lambda_over_na: req.pitch_lambda_over_na,
         intensity,
-        defocus_f: split.f,
-        tilt_shift: split.tilt_shift,
+        defocus_f: f,
+        tilt_shift,
         beta_degree: be.degree,
         beta_truncation_error: be.truncation_error,
         beta_energy,
@@ -549,7 +576,7 @@ pub fn compute_psf(req: &PsfRequest) -> Result<Psf, OpticsError> {
         radial_step,
         radial_taps,
         radial_nodes,
-        seconds_beta: (t1 - t0).as_secs_f64(),
+        seconds_beta: 0.0,
         seconds_coefficients: (t1b - t1).as_secs_f64(),
         seconds_table: (t2 - t1b).as_secs_f64(),
         seconds_synthesis: (t3 - t2).as_secs_f64(),
