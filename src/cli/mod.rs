@@ -6,6 +6,7 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod devices;
+mod kernels;
 mod psf;
 mod raster;
 
@@ -37,6 +38,8 @@ pub enum Command {
     Psf(psf::PsfArgs),
     /// Rasterise a scene to linear HDR colour and metric depth (EXR), plus an optional PNG.
     Raster(raster::RasterArgs),
+    /// Precompute an eye's PSF kernel grid (cached), with an optional contact sheet and plot.
+    Kernels(Box<kernels::KernelsArgs>),
 }
 
 impl Cli {
@@ -53,5 +56,6 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Devices(args) => devices::run(&cli, args),
         Command::Raster(args) => raster::run(&cli, args),
         Command::Psf(args) => psf::run(args),
+        Command::Kernels(args) => kernels::run(args),
     }
 }

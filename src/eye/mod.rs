@@ -13,6 +13,7 @@ pub mod presets;
 pub mod show;
 pub mod surface;
 pub mod system;
+pub mod test_eyes;
 pub mod trace;
 
 pub use accommodate::{accommodate, Accommodation};

@@ -1,3 +1,19 @@
 //! Point-spread functions turned into screen-space kernels (pure numerics, no GPU).
+//!
+//! - [`axes`]: the grid's axes, the screen and the numerical settings.
+//! - [`defocus`]: one (pupil, focus) state of an eye and the defocus of every object distance.
+//! - [`project`]: PSF sampling, energy crop, area-weighted resampling, screen orientation.
+//! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs.
+//! - [`exact`]: exact kernels at any vergence for the ground truth.
+//! - [`cache`]: grid files and the on-disk cache; [`preview`]: contact sheet and size plot.
+//! - [`kernels`]: the contract with the GPU runtime.
 
+pub mod axes;
+pub mod cache;
+pub mod defocus;
+pub mod exact;
+pub mod grid;
 pub mod kernels;
+pub mod plan;
+pub mod preview;
+pub mod project;

@@ -1,0 +1,331 @@
+//! `ocular kernels`: precompute an eye's kernel grid, write it, and optionally draw a contact
+//! sheet and the projected-size plot.
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use crate::eye::test_eyes::{test_eye, TEST_EYE_NAMES};
+use crate::eye::{presets::PRESET_NAMES, Eye};
+use crate::psf::axes::{GridAxes, KernelSettings, Screen};
+use crate::psf::cache::{cached, default_cache_dir, grid_key, write_grid, CacheOutcome};
+use crate::psf::grid::{compute_grid, GridReport, Stage};
+use crate::psf::kernels::DioptreAxis;
+use crate::psf::plan::{plan_for_scene, SceneNeeds};
+use crate::psf::preview;
+use crate::{Error, Result};
+
+#[derive(Debug, Args)]
+pub struct KernelsArgs {
+    /// The eye: a TOML eye file or a preset name.
+    #[arg(long, value_name = "FILE|NAME")]
+    pub eye: String,
+    /// Object distances in dioptres: MIN..MAX:COUNT, uniform [default: 0.125..10.125:41].
+    #[arg(long, value_name = "MIN..MAX:N")]
+    pub objects: Option<String>,
+    /// Focus states in dioptres, comma-separated, increasing; 0 = infinity
+    /// [default: 5 values over 0.125..10.125].
+    #[arg(long, value_name = "LIST")]
+    pub focus_d: Option<String>,
+    /// Pupil diameters in mm, comma-separated, increasing [default: 4 values over 2..7].
+    #[arg(long, value_name = "LIST")]
+    pub pupils_mm: Option<String>,
+    /// R, G, B wavelengths in nm [default: 612,549,464].
+    #[arg(long, value_name = "R,G,B")]
+    pub wavelengths_nm: Option<String>,
+    /// Vertical field of view of the output (degrees).
+    #[arg(long, default_value_t = 60.0)]
+    pub fov_y: f64,
+    /// Output image height (pixels).
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Largest kernel radius (px); larger natural radii are clamped.
+    #[arg(long, default_value_t = 64)]
+    pub rmax_cap: u32,
+    /// Fraction of each PSF's energy the cropped kernel keeps.
+    #[arg(long, default_value_t = 0.999)]
+    pub energy: f64,
+    /// Only what a scene needs: its depth range in dioptres (MIN..MAX); with one --focus-d and
+    /// one --pupils-mm value this is a single column of the grid.
+    #[arg(long, value_name = "MIN..MAX")]
+    pub scene_d: Option<String>,
+    /// Cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    pub cache: Option<PathBuf>,
+    /// Neither read nor write the cache.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Output grid file.
+    #[arg(short = 'o', long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Contact sheet PNG: kernels per object distance and channel.
+    #[arg(long, value_name = "PNG")]
+    pub preview: Option<PathBuf>,
+    /// Plot PNG: projected PSF size against object dioptres per channel for two focus states.
+    #[arg(long, value_name = "PNG")]
+    pub plot: Option<PathBuf>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// An eye from a TOML file or a preset / test-eye name.
+pub fn load_eye(spec: &str) -> Result<Eye> {
+    let path = Path::new(spec);
+    if path.is_file() {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
+        return Eye::from_toml_str(&text).map_err(|e| Error::file(path, e));
+    }
+    Eye::preset(spec).or_else(|| test_eye(spec)).ok_or_else(|| {
+        Error::input(format!(
+            "--eye {spec:?}: no such file or preset; presets: {}, {}",
+            PRESET_NAMES.join(", "),
+            TEST_EYE_NAMES.join(", ")
+        ))
+    })
+}
+
+fn parse_list(option: &str, text: &str) -> Result<Vec<f64>> {
+    text.split(',')
+        .map(|t| {
+            t.trim().parse::<f64>().map_err(|_| {
+                Error::input(format!(
+                    "--{option}: {t:?} is not a number (expected a comma-separated list)"
+                ))
+            })
+        })
+        .collect()
+}
+
+fn parse_range(option: &str, text: &str) -> Result<(f64, f64)> {
+    let bad = || Error::input(format!("--{option}: expected MIN..MAX, got {text:?}"));
+    let (a, b) = text.split_once("..").ok_or_else(bad)?;
+    let a = a.trim().parse::<f64>().map_err(|_| bad())?;
+    let b = b.trim().parse::<f64>().map_err(|_| bad())?;
+    if !(a.is_finite() && b.is_finite() && a <= b) {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+/// `MIN..MAX:N` → an object axis.
+pub fn parse_objects(text: &str) -> Result<DioptreAxis> {
+    let bad = || {
+        Error::input(format!(
+            "--objects: expected MIN..MAX:N (dioptres, N >= 1), got {text:?}"
+        ))
+    };
+    let (range, count) = text.rsplit_once(':').ok_or_else(bad)?;
+    let (lo, hi) = parse_range("objects", range)?;
+    let count: usize = count.trim().parse().map_err(|_| bad())?;
+    if count == 0 || (count == 1 && hi != lo) {
+        return Err(bad());
+    }
+    Ok(DioptreAxis::spanning(lo, hi, count))
+}
+
+struct Bars {
+    bar: Option<ProgressBar>,
+    stage: Mutex<Option<Stage>>,
+}
+
+impl Bars {
+    fn new() -> Bars {
+        Bars {
+            bar: std::io::stderr().is_terminal().then(ProgressBar::hidden),
+            stage: Mutex::new(None),
+        }
+    }
+
+    fn update(&self, stage: Stage, done: usize, total: usize) {
+        let Some(bar) = &self.bar else { return };
+        let mut current = self.stage.lock().unwrap_or_else(|e| e.into_inner());
+        if *current != Some(stage) {
+            *current = Some(stage);
+            let label = match stage {
+                Stage::Optics => "focusing and measuring",
+                Stage::Psfs => "PSFs",
+                Stage::Kernels => "kernels",
+            };
+            bar.reset();
+            bar.set_length(total as u64);
+            bar.set_style(
+                ProgressStyle::with_template(&format!(
+                    "{label:>24} [{{bar:40}}] {{pos}}/{{len}} ETA {{eta}}"
+                ))
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        bar.set_position(done as u64);
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+#[derive(serde::Serialize)]
+struct Summary<'a> {
+    output: String,
+    key: String,
+    cache: &'a CacheOutcome,
+    seconds: f64,
+    psfs: usize,
+    psfs_skipped: usize,
+    sets: usize,
+    objects: DioptreAxis,
+    max_radius_px: u32,
+    bytes_per_set: u64,
+    report: Option<&'a GridReport>,
+    plan_notes: &'a [String],
+}
+
+pub fn run(args: &KernelsArgs) -> Result<()> {
+    let eye = load_eye(&args.eye)?;
+    let mut axes = GridAxes::default();
+    if let Some(text) = &args.wavelengths_nm {
+        let wl = parse_list("wavelengths-nm", text)?;
+        axes.wavelengths_nm = wl.try_into().map_err(|_| {
+            Error::input("--wavelengths-nm: exactly three values (R,G,B) are required")
+        })?;
+    }
+    if let Some(text) = &args.objects {
+        axes.objects = parse_objects(text)?;
+    }
+    if let Some(text) = &args.focus_d {
+        axes.focus_d = parse_list("focus-d", text)?;
+    }
+    if let Some(text) = &args.pupils_mm {
+        axes.pupils_mm = parse_list("pupils-mm", text)?;
+    }
+    axes.validate()
+        .map_err(|e| Error::input(format!("--{e}")))?;
+    let screen = Screen {
+        fov_y_deg: args.fov_y,
+        height_px: args.height,
+    };
+    screen
+        .validate()
+        .map_err(|e| Error::input(format!("--{e}")))?;
+    let settings = KernelSettings {
+        max_radius_cap: args.rmax_cap,
+        energy: args.energy,
+        ..KernelSettings::default()
+    };
+    settings.validate().map_err(|e| {
+        Error::input(
+            e.replace("max_radius_cap", "--rmax-cap")
+                .replace("energy", "--energy"),
+        )
+    })?;
+    let mut skipped = 0;
+    let mut notes = Vec::new();
+    if let Some(range) = &args.scene_d {
+        let (lo, hi) = parse_range("scene-d", range)?;
+        let plan = plan_for_scene(
+            &SceneNeeds {
+                dioptre_min: lo,
+                dioptre_max: hi,
+                focus_d: axes.focus_d.clone(),
+                pupils_mm: axes.pupils_mm.clone(),
+                screen,
+            },
+            &axes,
+        )
+        .map_err(|e| Error::input(format!("--scene-d: {e}")))?;
+        skipped = plan.skipped_psfs;
+        notes = plan.notes;
+        axes = plan.axes;
+    }
+    let key = grid_key(&eye, &axes, &screen, &settings);
+    let dir = if args.no_cache {
+        None
+    } else {
+        args.cache.clone().or_else(default_cache_dir)
+    };
+    let bars = Bars::new();
+    let t = Instant::now();
+    let progress = |s: Stage, d: usize, n: usize| bars.update(s, d, n);
+    let (grid, report, outcome) = cached(dir.as_deref(), &key, || {
+        compute_grid(&eye, &axes, &screen, &settings, &progress)
+    })?;
+    bars.finish();
+    match &outcome {
+        CacheOutcome::Stored {
+            warning: Some(w), ..
+        } => eprintln!("warning: {w}"),
+        CacheOutcome::WriteFailed(w) => eprintln!("warning: {w}"),
+        _ => {}
+    }
+    write_grid(&args.output, &grid, &key)?;
+    if let Some(p) = &args.preview {
+        preview::write_png(p, &preview::contact_sheet(&grid))?;
+    }
+    if let Some(p) = &args.plot {
+        preview::write_png(p, &preview::size_plot(&grid))?;
+    }
+    let summary = Summary {
+        output: args.output.display().to_string(),
+        key,
+        cache: &outcome,
+        seconds: t.elapsed().as_secs_f64(),
+        psfs: axes.psf_count(),
+        psfs_skipped: skipped,
+        sets: grid.sets.len(),
+        objects: grid.objects,
+        max_radius_px: grid.max_radius_px,
+        bytes_per_set: grid.sets[0].size_bytes(),
+        report: report.as_ref(),
+        plan_notes: &notes,
+    };
+    if args.json {
+        let text = serde_json::to_string_pretty(&summary)
+            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
+        println!("{text}");
+    } else {
+        let source = match &outcome {
+            CacheOutcome::Hit(p) => format!("loaded from cache {}", p.display()),
+            _ => format!("computed in {:.1} s", summary.seconds),
+        };
+        println!(
+            "{}: {} sets (pupils {:?} mm × focus {:?} D), {} objects {:.3}..{:.3} D, Rmax {} px, \
+             {:.1} MiB per set; {} PSFs ({} skipped), {source}",
+            summary.output,
+            summary.sets,
+            grid.pupils_mm,
+            grid.focus_d,
+            grid.objects.count,
+            grid.objects.min_d,
+            grid.objects.max_d(),
+            grid.max_radius_px,
+            summary.bytes_per_set as f64 / (1 << 20) as f64,
+            summary.psfs,
+            skipped,
+        );
+        for n in &notes {
+            println!("  plan: {n}");
+        }
+        if let Some(r) = &report {
+            for c in &r.columns {
+                println!(
+                    "  pupil {:.2} mm, focus {:.3} D: lens {:.3} mm{}, residual R/G/B {:+.3} {:+.3} {:+.3} D, beta degree {:?}",
+                    c.pupil_mm,
+                    c.focus_d,
+                    c.lens_diameter_mm,
+                    if c.beyond_far_point { " (beyond far point: relaxed)" } else { "" },
+                    c.residual_d[0],
+                    c.residual_d[1],
+                    c.residual_d[2],
+                    c.beta_degree
+                );
+            }
+        }
+    }
+    Ok(())
+}
