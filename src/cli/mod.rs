@@ -5,10 +5,14 @@ use clap::{Parser, Subcommand};
 use crate::gpu::ContextOptions;
 use crate::Result;
 
+mod bench;
+mod compare;
 mod devices;
 mod kernels;
 mod psf;
 mod raster;
+mod render;
+mod video;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -32,6 +36,14 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Render a scene (or colour + depth EXRs) as an eye sees it — the main job.
+    Render(Box<render::RenderArgs>),
+    /// Export an animation (or a focus sweep) frame by frame; resumable and splittable.
+    Video(Box<video::VideoArgs>),
+    /// Time every GPU pass over many frames (mean / median / p95), with precomputation times.
+    Bench(Box<bench::BenchArgs>),
+    /// Ground truth vs splatting vs depth slices: PSNR, MSSIM, time, SSIM maps.
+    Compare(Box<compare::CompareArgs>),
     /// List the Vulkan devices and mark the one ocular would use.
     Devices(devices::DevicesArgs),
     /// Compute one point-spread function from Zernike coefficients (EXR + JSON sidecar).
@@ -53,6 +65,10 @@ impl Cli {
 
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
+        Command::Render(args) => render::run(&cli, args),
+        Command::Video(args) => video::run(&cli, args),
+        Command::Bench(args) => bench::run(&cli, args),
+        Command::Compare(args) => compare::run(&cli, args),
         Command::Devices(args) => devices::run(&cli, args),
         Command::Raster(args) => raster::run(&cli, args),
         Command::Psf(args) => psf::run(args),

@@ -59,7 +59,7 @@ pub struct RasterArgs {
     pub tonemap: TonemapArg,
 }
 
-fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> {
+pub(crate) fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = text
         .split_once(['x', 'X', '×'])
         .ok_or_else(|| format!("\"{text}\": expected WIDTHxHEIGHT, e.g. 1280x720"))?;

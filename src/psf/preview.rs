@@ -86,6 +86,37 @@ pub fn text(img: &mut RgbImage, x: i64, y: i64, scale: i64, color: Rgb<u8>, s: &
     }
 }
 
+/// Draws a white label on a dark box into a linear float image (for labelled video panels).
+pub fn draw_label(image: &mut crate::image_io::ImageRgba, x: u32, y: u32, label: &str) {
+    const SCALE: u32 = 2;
+    let (w, h) = (image.width, image.height);
+    let box_w = (label.chars().count() as u32 * 6 + 2) * SCALE;
+    let box_h = 9 * SCALE;
+    for py in y..(y + box_h).min(h) {
+        for px in x..(x + box_w).min(w) {
+            image.pixels[(py * w + px) as usize] = [0.02, 0.02, 0.02, 1.0];
+        }
+    }
+    for (k, c) in label.chars().enumerate() {
+        for (row, bits) in glyph(c).iter().enumerate() {
+            for col in 0..5u32 {
+                if bits & (16 >> col) == 0 {
+                    continue;
+                }
+                for dy in 0..SCALE {
+                    for dx in 0..SCALE {
+                        let px = x + SCALE + (k as u32 * 6 + col) * SCALE + dx;
+                        let py = y + SCALE + row as u32 * SCALE + dy;
+                        if px < w && py < h {
+                            image.pixels[(py * w + px) as usize] = [1.0, 1.0, 1.0, 1.0];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 fn put(img: &mut RgbImage, x: i64, y: i64, c: Rgb<u8>) {
     if x >= 0 && y >= 0 && (x as u32) < img.width() && (y as u32) < img.height() {
         img.put_pixel(x as u32, y as u32, c);

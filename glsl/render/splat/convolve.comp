@@ -16,16 +16,52 @@ layout(std430, binding = 3) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 4) readonly buffer Entries { uvec2 entries[]; };
 layout(binding = 5, rgba32f) writeonly uniform image2D color_out;
 
-const uint MAX_PIXELS_PER_THREAD = 16u; // 32-pixel tiles on 8×8 threads
+// The tile side is fixed per pipeline, so the per-thread pixel arrays have a compile-time
+// size and live in registers (dynamic sizes cost CPU implementations such as lavapipe dearly).
+layout(constant_id = 0) const uint TILE = 8u;
+const uint PER_AXIS = TILE / 8u;
+const uint PIXELS = PER_AXIS * PER_AXIS;
 shared Fragment batch[64];
 
-float kernel_weight(vec2 d, float r, float index, int channel) {
+// RGB kernel values at integer radius r (divided by the (2r+1)² storage scale).
+vec3 kernel_rgb(vec2 d, float r, float index) {
     float side = float(2u * frame.max_radius + 1u);
     float layers = float(frame.object_count * (frame.max_radius + 1u));
     vec3 uvw = vec3((float(frame.max_radius) + 0.5 + d) / side,
                     (r * float(frame.object_count) + index + 0.5) / layers);
     float k = 2.0 * r + 1.0;
-    return textureLod(psf_texture, uvw, 0.0)[channel] / (k * k);
+    return textureLod(psf_texture, uvw, 0.0).rgb / (k * k);
+}
+
+// Per-channel weight of fragment f at offset d: each channel's radius lies between two integer
+// radii; when all channels' radii fall within three consecutive integers (the usual case), the
+// three lookups serve every channel, else each channel takes its own two.
+vec3 fragment_weight(Fragment f, vec2 d) {
+    vec3 lo = floor(f.radius);
+    vec3 t = f.radius - lo;
+    float base = min(lo.r, min(lo.g, lo.b));
+    float top = max(ceil(f.radius.r), max(ceil(f.radius.g), ceil(f.radius.b)));
+    vec3 w;
+    if (top - base <= 2.0) {
+        vec3 s0 = kernel_rgb(d, base, f.index);
+        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index) : s0;
+        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index) : s1;
+        // Component-wise selection (no dynamic indexing): channel c reads s[i0] and s[i0 + 1].
+        vec3 i0 = lo - base;
+        vec3 a = mix(mix(s0, s1, step(0.5, i0)), s2, step(1.5, i0));
+        vec3 b = mix(s1, s2, step(0.5, i0));
+        w = mix(a, b, t);
+    } else {
+        for (int c = 0; c < 3; c++) {
+            float a = kernel_rgb(d, lo[c], f.index)[c];
+            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index)[c], t[c]) : a;
+        }
+    }
+    if (f.size > 1u) {
+        // A merged block covers size² pixels' worth of the same light.
+        w = vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(float(f.size * f.size)));
+    }
+    return w;
 }
 
 void main() {
@@ -37,12 +73,14 @@ void main() {
     uint ty = tile / frame.tiles_x;
     uint n = counts[tile];
     uint base = offsets[tile] - frame.band_first_entry;
-    uint per_axis = frame.tile_size / 8u;
     uint local_index = gl_LocalInvocationIndex;
 
-    vec3 C[MAX_PIXELS_PER_THREAD];
-    vec3 A[MAX_PIXELS_PER_THREAD];
-    for (uint q = 0u; q < MAX_PIXELS_PER_THREAD; q++) {
+    vec2 centre[PIXELS];
+    vec3 C[PIXELS];
+    vec3 A[PIXELS];
+    for (uint q = 0u; q < PIXELS; q++) {
+        uvec2 pixel = uvec2(tx, ty) * TILE + gl_LocalInvocationID.xy + 8u * uvec2(q % PER_AXIS, q / PER_AXIS);
+        centre[q] = vec2(pixel) + 0.5;
         C[q] = vec3(0.0);
         A[q] = vec3(0.0);
     }
@@ -56,37 +94,21 @@ void main() {
         for (uint j = 0u; j < batch_size; j++) {
             Fragment f = batch[j];
             float reach = fragment_reach(f);
-            float exponent = float(f.size * f.size);
-            for (uint q = 0u; q < per_axis * per_axis; q++) {
-                uvec2 pixel = uvec2(tx, ty) * frame.tile_size + gl_LocalInvocationID.xy
-                    + 8u * uvec2(q % per_axis, q / per_axis);
-                vec2 d = vec2(pixel) + 0.5 - f.center;
+            for (uint q = 0u; q < PIXELS; q++) {
+                vec2 d = centre[q] - f.center;
                 if (abs(d.x) > reach || abs(d.y) > reach) {
                     continue;
                 }
-                for (int c = 0; c < 3; c++) {
-                    float radius = f.radius[c];
-                    float r0 = floor(radius);
-                    float r1 = ceil(radius);
-                    float w = kernel_weight(d, r0, f.index, c);
-                    if (r1 > r0) {
-                        w = mix(w, kernel_weight(d, r1, f.index, c), radius - r0);
-                    }
-                    if (f.size > 1u) {
-                        // A merged block covers size² pixels' worth of the same light.
-                        w = 1.0 - pow(max(1.0 - w, 0.0), exponent);
-                    }
-                    C[q][c] += (1.0 - A[q][c]) * w * f.color[c];
-                    A[q][c] += (1.0 - A[q][c]) * w;
-                }
+                vec3 w = fragment_weight(f, d);
+                C[q] += (vec3(1.0) - A[q]) * w * f.color;
+                A[q] += (vec3(1.0) - A[q]) * w;
             }
         }
         barrier();
     }
 
-    for (uint q = 0u; q < per_axis * per_axis; q++) {
-        uvec2 pixel = uvec2(tx, ty) * frame.tile_size + gl_LocalInvocationID.xy
-            + 8u * uvec2(q % per_axis, q / per_axis);
+    for (uint q = 0u; q < PIXELS; q++) {
+        uvec2 pixel = uvec2(centre[q]);
         if (pixel.x < frame.width && pixel.y < frame.height) {
             vec3 a = A[q];
             vec3 color = vec3(a.r > 0.0 ? C[q].r / a.r : 0.0,

@@ -14,6 +14,10 @@ layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 2) coherent buffer Entries { uvec2 entries[]; };
 
 const uint SHARED_CAPACITY = 2048u;
+// Up to this length a rank sort (each key counts the keys before it) needs one barrier
+// instead of the network's log² n: much cheaper on CPU implementations, and keys are unique
+// (the fragment index breaks ties), so ranks are a permutation.
+const uint RANK_SORT_LIMIT = 512u;
 shared uvec2 keys[SHARED_CAPACITY];
 
 void main() {
@@ -29,6 +33,19 @@ void main() {
     uint t = gl_LocalInvocationID.x;
     uint m = 1u;
     while (m < n) m <<= 1u;
+    if (n <= RANK_SORT_LIMIT) {
+        for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
+        barrier();
+        for (uint i = t; i < n; i += 256u) {
+            uvec2 key = keys[i];
+            uint rank = 0u;
+            for (uint j = 0u; j < n; j++) {
+                rank += key_less(keys[j], key) ? 1u : 0u;
+            }
+            entries[base + rank] = key;
+        }
+        return;
+    }
     bool in_shared = n <= SHARED_CAPACITY;
     if (in_shared) {
         for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];

@@ -13,7 +13,7 @@ pub(super) struct ConvolvePass {
 }
 
 impl ConvolvePass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+    pub fn new(ctx: &Context, tile_size: u32) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
                 .bindings(&[
@@ -25,6 +25,7 @@ impl ConvolvePass {
                     BindingKind::StorageImage,
                 ])
                 .push_constants::<FrameParams>()
+                .specialize(0, tile_size)
                 .build(ctx)?;
         Ok(ConvolvePass { pipeline })
     }

@@ -259,7 +259,7 @@ impl Splatter {
             prefix_sum: prefix_sum::PrefixSumPass::new(ctx)?,
             tile_fill: tile_fill::TileFillPass::new(ctx)?,
             tile_sort: tile_sort::TileSortPass::new(ctx)?,
-            convolve: convolve::ConvolvePass::new(ctx)?,
+            convolve: convolve::ConvolvePass::new(ctx, settings.tile_size)?,
             grid,
         })
     }

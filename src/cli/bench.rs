@@ -1,0 +1,362 @@
+//! `ocular bench`: the GPU timing harness. One rasterised frame of a scene is splatted M times
+//! after N warm-up frames; every pass is timed with GPU timestamp queries, and mean / median /
+//! p95 are reported per pass and for the total, beside the precomputation times, in the layout
+//! of the seed paper's Table 3. `--compare-methods` adds the ground truth and the slice method.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+
+use super::raster::parse_size;
+use super::render::load_eye;
+use super::Cli;
+use crate::gpu::Context;
+use crate::psf::axes::Screen;
+use crate::render::frame::{
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+};
+use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
+use crate::render::Rasterizer;
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    ocular bench --scene primitives --eye myopia --size 1280x720\n  \
+    ocular bench --scene colonnade --eye keratoconus --frames 20 --compare-methods --json bench.json\n\n\
+GPU times come from timestamp queries around each pass; the total is the sum of the passes of \
+one frame. On a CPU implementation (lavapipe) the figures measure the CPU, not a GPU.")]
+pub struct BenchArgs {
+    /// Built-in scene or a scene .toml file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "primitives")]
+    pub scene: String,
+    /// Eye preset or eye .toml file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
+    pub eye: String,
+    /// Frame size.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x720")]
+    pub size: (u32, u32),
+    /// Frames rendered before timing starts (shader compilation, caches).
+    #[arg(long, default_value_t = 5)]
+    pub warmup: usize,
+    /// Timed frames.
+    #[arg(long, default_value_t = 100)]
+    pub frames: usize,
+    /// Pupil diameter (default: the scene's, else 5 mm as in the seed paper's tests).
+    #[arg(long, value_name = "MM")]
+    pub pupil_mm: Option<f64>,
+    /// Screen tile size: 8, 16 or 32.
+    #[arg(long, default_value_t = 8)]
+    pub tile_size: u32,
+    #[arg(long, value_enum, default_value = "rgba16f")]
+    pub texture_format: PsfTextureFormat,
+    /// Fragment merging: 0 = off, 1 = 2×2, 2 = also 4×4.
+    #[arg(long, default_value_t = 1)]
+    pub merge_levels: u32,
+    /// Also time the ground truth and the slice method once each, and print speed ratios.
+    #[arg(long)]
+    pub compare_methods: bool,
+    /// Kernel cache folder (default: the user cache); --no-cache times the precomputation.
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    pub cache: Option<PathBuf>,
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Write the results as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Stat {
+    pub name: String,
+    pub mean_ms: f64,
+    pub median_ms: f64,
+    pub p95_ms: f64,
+}
+
+/// Mean, median and 95th percentile (nearest rank) of samples in ms.
+pub fn stat(name: &str, samples: &[f64]) -> Stat {
+    let mut sorted = samples.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len().max(1);
+    let mean = sorted.iter().sum::<f64>() / n as f64;
+    let median = if sorted.is_empty() {
+        0.0
+    } else if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    };
+    let rank = ((0.95 * n as f64).ceil() as usize).clamp(1, n);
+    let p95 = sorted.get(rank - 1).copied().unwrap_or(0.0);
+    Stat {
+        name: name.to_string(),
+        mean_ms: mean,
+        median_ms: median,
+        p95_ms: p95,
+    }
+}
+
+#[derive(serde::Serialize)]
+struct MethodTime {
+    method: &'static str,
+    seconds: f64,
+    ratio_to_splat: f64,
+}
+
+#[derive(serde::Serialize)]
+struct Report {
+    device: String,
+    driver: String,
+    scene: String,
+    eye: String,
+    width: u32,
+    height: u32,
+    warmup: usize,
+    frames: usize,
+    focus_d: f64,
+    pupil_mm: f64,
+    precompute: Precompute,
+    passes: Vec<Stat>,
+    total: Stat,
+    wall_ms_per_frame: Stat,
+    list_entries: u64,
+    max_radius_px: u32,
+    methods: Vec<MethodTime>,
+}
+
+#[derive(serde::Serialize)]
+struct Precompute {
+    from_cache: bool,
+    psfs: usize,
+    seconds_eye_optics: f64,
+    seconds_psfs: f64,
+    seconds_kernels: f64,
+    seconds_total: f64,
+}
+
+pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
+    if args.frames == 0 {
+        return Err(Error::input("--frames must be at least 1"));
+    }
+    let splat = SplatSettings {
+        tile_size: args.tile_size,
+        texture_format: args.texture_format,
+        merge: MergeSettings {
+            levels: args.merge_levels,
+            ..MergeSettings::default()
+        },
+        ..SplatSettings::default()
+    };
+    splat
+        .validate()
+        .map_err(|e| Error::input(format!("--tile-size / --merge-levels: {e}")))?;
+    let eye = load_eye(&args.eye)?;
+    let scene = Scene::load(&args.scene)?;
+    let ctx = Context::new(&cli.context_options())?;
+    let state = scene.at_time(0.0);
+    let (width, height) = args.size;
+    let frame = Rasterizer::new(&ctx)?.render(&ctx, &state, width, height)?;
+    let focus_d = if state.focus_m.is_finite() && state.focus_m > 0.0 {
+        1.0 / state.focus_m
+    } else {
+        0.0
+    };
+    let pupil_mm = args.pupil_mm.or(state.pupil_mm).unwrap_or(5.0);
+    if !(1.0..=9.0).contains(&pupil_mm) {
+        return Err(Error::input(format!(
+            "--pupil-mm {pupil_mm} is outside 1–9 mm"
+        )));
+    }
+    let eye_state = EyeState { focus_d, pupil_mm };
+    let screen = Screen {
+        fov_y_deg: state.camera.fov_y_deg,
+        height_px: height,
+    };
+    let mut options = KernelOptions::default();
+    if args.no_cache {
+        options.cache_dir = None;
+    } else if let Some(dir) = &args.cache {
+        options.cache_dir = Some(dir.clone());
+    }
+    let kernels = prepare_kernels(
+        &eye,
+        &scene_needs(&[dioptre_range(&frame.depth_m)], &[eye_state], screen),
+        &options,
+    )?;
+    let precompute = Precompute {
+        from_cache: kernels.report.is_none(),
+        psfs: kernels.report.as_ref().map_or(0, |r| r.psfs_computed),
+        seconds_eye_optics: kernels.report.as_ref().map_or(0.0, |r| r.seconds_optics),
+        seconds_psfs: kernels.report.as_ref().map_or(0.0, |r| r.seconds_psfs),
+        seconds_kernels: kernels.report.as_ref().map_or(0.0, |r| r.seconds_kernels),
+        seconds_total: kernels.seconds,
+    };
+    let max_radius_px = kernels.grid.max_radius_px;
+    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    let input = FrameInput {
+        width,
+        height,
+        color: &frame.color,
+        depth_m: &frame.depth_m,
+    };
+
+    let bar = frame_bar((args.warmup + args.frames) as u64);
+    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut totals = Vec::with_capacity(args.frames);
+    let mut walls = Vec::with_capacity(args.frames);
+    let mut list_entries = 0;
+    for i in 0..args.warmup + args.frames {
+        let started = Instant::now();
+        let out = renderer.render(&input, eye_state, Method::Splat)?;
+        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+        bar.inc(1);
+        if i < args.warmup {
+            continue;
+        }
+        let timings = out.timings.unwrap_or_default();
+        for pass in &timings.passes {
+            match per_pass.iter_mut().find(|(n, _)| *n == pass.name) {
+                Some((_, v)) => v.push(pass.ms),
+                None => per_pass.push((pass.name.clone(), vec![pass.ms])),
+            }
+        }
+        totals.push(timings.total_ms());
+        walls.push(wall_ms);
+        list_entries = out.stats.map_or(0, |s| s.list_entries);
+    }
+    bar.finish_and_clear();
+    let splat_total = stat("total", &totals);
+    let mut methods = Vec::new();
+    if args.compare_methods {
+        let splat_seconds = stat("wall", &walls).mean_ms / 1e3;
+        methods.push(MethodTime {
+            method: "splat",
+            seconds: splat_seconds,
+            ratio_to_splat: 1.0,
+        });
+        for method in [Method::Reference, Method::Slices] {
+            let out = renderer.render(&input, eye_state, method)?;
+            methods.push(MethodTime {
+                method: method.name(),
+                seconds: out.seconds,
+                ratio_to_splat: out.seconds / splat_seconds,
+            });
+        }
+    }
+    let info = ctx.device_info();
+    let report = Report {
+        device: info.name.clone(),
+        driver: info.driver.clone(),
+        scene: args.scene.clone(),
+        eye: args.eye.clone(),
+        width,
+        height,
+        warmup: args.warmup,
+        frames: args.frames,
+        focus_d,
+        pupil_mm,
+        precompute,
+        passes: per_pass.iter().map(|(n, v)| stat(n, v)).collect(),
+        total: splat_total,
+        wall_ms_per_frame: stat("wall", &walls),
+        list_entries,
+        max_radius_px,
+        methods,
+    };
+    print_table(&report);
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
+        crate::image_io::write_text_atomic(path, &text)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn frame_bar(total: u64) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "frames [{bar:30}] {pos}/{len} {per_sec} ETA {eta}",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar
+}
+
+fn print_table(r: &Report) {
+    println!(
+        "ocular bench — {} through eye {} at {}×{} on {} ({})",
+        r.scene, r.eye, r.width, r.height, r.device, r.driver
+    );
+    println!(
+        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} list entries/frame",
+        r.focus_d, r.pupil_mm, r.max_radius_px, r.list_entries
+    );
+    println!();
+    let p = &r.precompute;
+    if p.from_cache {
+        println!(
+            "precomputation: kernels loaded from the cache in {:.2} s (--no-cache to time it)",
+            p.seconds_total
+        );
+    } else {
+        println!("precomputation ({} PSFs)", p.psfs);
+        println!("  {:<22} {:>9.2} s", "eye optics", p.seconds_eye_optics);
+        println!("  {:<22} {:>9.2} s", "PSFs", p.seconds_psfs);
+        println!("  {:<22} {:>9.2} s", "kernels", p.seconds_kernels);
+        println!("  {:<22} {:>9.2} s", "total (with I/O)", p.seconds_total);
+    }
+    println!();
+    println!(
+        "runtime over {} frames after {} warm-up (GPU timestamps, ms)",
+        r.frames, r.warmup
+    );
+    println!(
+        "  {:<22} {:>10} {:>10} {:>10}",
+        "pass", "mean", "median", "p95"
+    );
+    for s in r.passes.iter().chain(std::iter::once(&r.total)) {
+        println!(
+            "  {:<22} {:>10.3} {:>10.3} {:>10.3}",
+            s.name, s.mean_ms, s.median_ms, s.p95_ms
+        );
+    }
+    let w = &r.wall_ms_per_frame;
+    println!(
+        "  {:<22} {:>10.3} {:>10.3} {:>10.3}   (CPU wall, upload and read-back included)",
+        "wall per frame", w.mean_ms, w.median_ms, w.p95_ms
+    );
+    if !r.methods.is_empty() {
+        println!();
+        println!("methods (wall seconds per frame)");
+        for m in &r.methods {
+            println!(
+                "  {:<22} {:>10.3} s  {:>8.1}× splat",
+                m.method, m.seconds, m.ratio_to_splat
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::stat;
+
+    #[test]
+    fn statistics_follow_their_definitions() {
+        let s = stat("x", &[5.0, 1.0, 3.0, 2.0, 4.0]);
+        assert_eq!((s.mean_ms, s.median_ms, s.p95_ms), (3.0, 3.0, 5.0));
+        let even = stat("x", &[4.0, 1.0, 3.0, 2.0]);
+        assert_eq!(even.median_ms, 2.5);
+        let many: Vec<f64> = (1..=100).map(f64::from).collect();
+        assert_eq!(stat("x", &many).p95_ms, 95.0);
+    }
+}

@@ -1,0 +1,259 @@
+//! `ocular compare`: the seed paper's Table 2 for one scene and eye — ground truth, tiled
+//! splatting and depth slices from the same kernels and inputs, with PSNR, MSSIM, time per
+//! method and speed ratios; optionally the images and false-colour SSIM maps (Figure 12).
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::raster::parse_size;
+use super::render::load_eye;
+use super::Cli;
+use crate::gpu::Context;
+use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
+use crate::psf::axes::Screen;
+use crate::render::frame::{
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+};
+use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
+use crate::render::Rasterizer;
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    ocular compare --scene primitives --eye myopia --size 320x180\n  \
+    ocular compare --scene primitives --eye keratoconus --json kc.json --maps maps/\n\n\
+Quality is measured against the ground truth on the linear image clamped to [0, 1] (PSNR with a \
+peak of 1; SSIM with Wang et al.'s settings). The ground truth computes one exact PSF per 0.001 D \
+bin and channel, on the CPU: it is slow by design.")]
+pub struct CompareArgs {
+    #[arg(long, value_name = "NAME|FILE", default_value = "primitives")]
+    pub scene: String,
+    #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
+    pub eye: String,
+    /// Frame size.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "320x180")]
+    pub size: (u32, u32),
+    /// Pupil diameter in mm (default: the scene's, else 5 mm as in the seed paper).
+    #[arg(long, value_name = "MM")]
+    pub pupil_mm: Option<f64>,
+    /// Depth slices for the slice method.
+    #[arg(long, default_value_t = 41)]
+    pub slices: usize,
+    #[arg(long, default_value_t = 8)]
+    pub tile_size: u32,
+    #[arg(long, value_enum, default_value = "rgba16f")]
+    pub texture_format: PsfTextureFormat,
+    #[arg(long, default_value_t = 1)]
+    pub merge_levels: u32,
+    /// Write the results as JSON.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Write truth.png, splat.png, slices.png and the SSIM maps (ssim_splat.png, ssim_slices.png).
+    #[arg(long, value_name = "DIR")]
+    pub maps: Option<PathBuf>,
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    pub cache: Option<PathBuf>,
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct MethodResult {
+    pub method: &'static str,
+    pub seconds: f64,
+    pub psnr_db: f64,
+    pub mssim: f64,
+    pub speedup_vs_reference: f64,
+}
+
+#[derive(serde::Serialize)]
+struct Report {
+    scene: String,
+    eye: String,
+    width: u32,
+    height: u32,
+    focus_d: f64,
+    pupil_mm: f64,
+    device: String,
+    methods: Vec<MethodResult>,
+}
+
+fn clamp01(image: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    image
+        .iter()
+        .map(|p| {
+            [
+                p[0].clamp(0.0, 1.0),
+                p[1].clamp(0.0, 1.0),
+                p[2].clamp(0.0, 1.0),
+                1.0,
+            ]
+        })
+        .collect()
+}
+
+pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
+    let splat = SplatSettings {
+        tile_size: args.tile_size,
+        texture_format: args.texture_format,
+        merge: MergeSettings {
+            levels: args.merge_levels,
+            ..MergeSettings::default()
+        },
+        ..SplatSettings::default()
+    };
+    splat
+        .validate()
+        .map_err(|e| Error::input(format!("--tile-size / --merge-levels: {e}")))?;
+    if args.slices == 0 {
+        return Err(Error::input("--slices must be at least 1"));
+    }
+    let eye = load_eye(&args.eye)?;
+    let scene = Scene::load(&args.scene)?;
+    let ctx = Context::new(&cli.context_options())?;
+    let state = scene.at_time(0.0);
+    let (width, height) = args.size;
+    let frame = Rasterizer::new(&ctx)?.render(&ctx, &state, width, height)?;
+    let focus_d = if state.focus_m.is_finite() && state.focus_m > 0.0 {
+        1.0 / state.focus_m
+    } else {
+        0.0
+    };
+    let pupil_mm = args.pupil_mm.or(state.pupil_mm).unwrap_or(5.0);
+    if !(1.0..=9.0).contains(&pupil_mm) {
+        return Err(Error::input(format!(
+            "--pupil-mm {pupil_mm} is outside 1–9 mm"
+        )));
+    }
+    let eye_state = EyeState { focus_d, pupil_mm };
+    let screen = Screen {
+        fov_y_deg: state.camera.fov_y_deg,
+        height_px: height,
+    };
+    let mut options = KernelOptions::default();
+    if args.no_cache {
+        options.cache_dir = None;
+    } else if let Some(dir) = &args.cache {
+        options.cache_dir = Some(dir.clone());
+    }
+    let kernels = prepare_kernels(
+        &eye,
+        &scene_needs(&[dioptre_range(&frame.depth_m)], &[eye_state], screen),
+        &options,
+    )?;
+    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    renderer.slice_count = args.slices;
+    let input = FrameInput {
+        width,
+        height,
+        color: &frame.color,
+        depth_m: &frame.depth_m,
+    };
+
+    let truth = renderer.render(&input, eye_state, Method::Reference)?;
+    // The first splat frame compiles shaders and uploads the kernels: time the second.
+    renderer.render(&input, eye_state, Method::Splat)?;
+    let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
+    let slices_frame = renderer.render(&input, eye_state, Method::Slices)?;
+
+    let (w, h) = (width as usize, height as usize);
+    let truth01 = clamp01(&truth.color);
+    let mut methods = Vec::new();
+    let mut maps = Vec::new();
+    for frame in [&truth, &splat_frame, &slices_frame] {
+        let image = clamp01(&frame.color);
+        let quality = ssim(
+            ImageView::new(w, h, &image),
+            ImageView::new(w, h, &truth01),
+            1.0,
+        );
+        methods.push(MethodResult {
+            method: frame.method.name(),
+            seconds: frame.seconds,
+            psnr_db: psnr(
+                ImageView::new(w, h, &image),
+                ImageView::new(w, h, &truth01),
+                1.0,
+            ),
+            mssim: quality.mean,
+            speedup_vs_reference: truth.seconds / frame.seconds.max(1e-12),
+        });
+        maps.push(quality.map);
+    }
+    println!(
+        "{} through eye {} at {width}×{height}, focus {focus_d:.3} D, pupil {pupil_mm:.2} mm ({})",
+        args.scene,
+        args.eye,
+        ctx.device_info().name
+    );
+    println!(
+        "  {:<10} {:>10} {:>10} {:>10} {:>12}",
+        "method", "PSNR dB", "MSSIM", "seconds", "× faster"
+    );
+    for m in &methods {
+        let db = if m.psnr_db.is_infinite() {
+            "∞".to_string()
+        } else {
+            format!("{:.2}", m.psnr_db)
+        };
+        println!(
+            "  {:<10} {:>10} {:>10.4} {:>10.3} {:>12.1}",
+            m.method, db, m.mssim, m.seconds, m.speedup_vs_reference
+        );
+    }
+    if let Some(dir) = &args.maps {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| Error::file(dir, format!("cannot create: {e}")))?;
+        let tonemap = Tonemap {
+            exposure_ev: 0.0,
+            mode: TonemapMode::Clamp,
+        };
+        for (name, frame) in [
+            ("truth", &truth),
+            ("splat", &splat_frame),
+            ("slices", &slices_frame),
+        ] {
+            image_io::write_png(
+                dir.join(format!("{name}.png")),
+                &ImageRgba::new(width, height, frame.color.clone()),
+                tonemap,
+            )?;
+        }
+        for (name, map) in [("ssim_splat", &maps[1]), ("ssim_slices", &maps[2])] {
+            let rgb: Vec<[f32; 4]> = ssim_false_colour(map, 0.9)
+                .iter()
+                .map(|p| [0, 1, 2].map(|c| image_io::srgb_decode(p[c])))
+                .map(|v| [v[0], v[1], v[2], 1.0])
+                .collect();
+            image_io::write_png(
+                dir.join(format!("{name}.png")),
+                &ImageRgba::new(width, height, rgb),
+                tonemap,
+            )?;
+        }
+        println!(
+            "wrote images and SSIM maps (1.0 → navy, ≤ 0.9 → red) to {}",
+            dir.display()
+        );
+    }
+    if let Some(path) = &args.json {
+        let report = Report {
+            scene: args.scene.clone(),
+            eye: args.eye.clone(),
+            width,
+            height,
+            focus_d,
+            pupil_mm,
+            device: ctx.device_info().name.clone(),
+            methods,
+        };
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
+        image_io::write_text_atomic(path, &text)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}

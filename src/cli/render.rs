@@ -1,0 +1,482 @@
+//! `ocular render`: the main job — a scene (or a colour + depth EXR pair) as a particular eye
+//! sees it. With no arguments: the `primitives` scene through the `myopia` eye into ocular.png.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use super::raster::{parse_size, TonemapArg};
+use super::Cli;
+use crate::eye::Eye;
+use crate::gpu::Context;
+use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
+use crate::psf::axes::Screen;
+use crate::psf::cache::CacheOutcome;
+use crate::render::frame::{
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+};
+use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
+use crate::render::Rasterizer;
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum PupilModel {
+    /// Watson & Yellott (2012) unified formula (field = the frame, one eye, --age).
+    WatsonYellott,
+    /// Moon & Spencer (1944), as Watson & Yellott quote it.
+    MoonSpencer,
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    ocular render                                   # primitives, myopia eye → ocular.png\n  \
+    ocular render --scene chart --eye keratoconus --focus-m 6 -o chart.png\n  \
+    ocular render --color c.exr --depth d.exr --fov-y 60 --eye astigmatism --focus-m 7.5 --pupil-mm 5 -o out.exr\n  \
+    ocular render --scene colonnade --focus-at 320,180 --luminance-cdm2 30 --timings\n\n\
+Focus: --focus-m/--focus-d, or --focus-at X,Y (the depth under that pixel), else the scene's \
+focus, else the depth at the frame's centre. Pupil: --pupil-mm, else from --luminance-cdm2, the \
+scene's pupil or luminance, or the frame's mean luminance (linear RGB is in cd/m²). Kernels are \
+computed only for what the frame needs and cached (see --cache).")]
+pub struct RenderArgs {
+    /// Built-in scene (primitives, chart, colonnade) or a scene .toml file.
+    #[arg(long, value_name = "NAME|FILE", conflicts_with = "color")]
+    pub scene: Option<String>,
+    /// Linear colour EXR (instead of a scene); needs --depth.
+    #[arg(long, value_name = "FILE.exr", requires = "depth")]
+    pub color: Option<PathBuf>,
+    /// Depth EXR in metres along the view axis (channel Z, depth, Y or R).
+    #[arg(long, value_name = "FILE.exr", requires = "color")]
+    pub depth: Option<PathBuf>,
+    /// Eye: a preset (see `ocular eye list`) or an eye .toml file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
+    pub eye: String,
+    /// Focus distance in metres (`inf` for infinity).
+    #[arg(long, value_name = "M", conflicts_with_all = ["focus_d", "focus_at"])]
+    pub focus_m: Option<String>,
+    /// Focus vergence in dioptres (0 = infinity).
+    #[arg(
+        long,
+        value_name = "D",
+        conflicts_with = "focus_at",
+        allow_negative_numbers = true
+    )]
+    pub focus_d: Option<f64>,
+    /// Focus on the depth under pixel X,Y (0-based, from the top left).
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
+    pub focus_at: Option<(u32, u32)>,
+    /// Entrance-pupil diameter in mm.
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub pupil_mm: Option<f64>,
+    /// Adapting luminance in cd/m² for the pupil model.
+    #[arg(
+        long,
+        value_name = "CD/M2",
+        conflicts_with = "pupil_mm",
+        allow_negative_numbers = true
+    )]
+    pub luminance_cdm2: Option<f64>,
+    /// Pupil formula for luminance-driven pupils.
+    #[arg(long, value_enum, default_value = "watson-yellott")]
+    pub pupil_model: PupilModel,
+    /// Observer age (years) for the Watson–Yellott formula.
+    #[arg(long, default_value_t = 30.0)]
+    pub age: f64,
+    /// Vertical field of view in degrees (EXR input; scenes use their camera's).
+    #[arg(long, value_name = "DEG")]
+    pub fov_y: Option<f64>,
+    /// Frame size for scenes (default 640x360).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Scene time in seconds (keyframes).
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
+    pub time: f64,
+    /// Rendering method.
+    #[arg(long, value_enum, default_value = "splat")]
+    pub method: Method,
+    /// Screen tile size for splatting: 8, 16 or 32.
+    #[arg(long, default_value_t = 8)]
+    pub tile_size: u32,
+    /// PSF texture format.
+    #[arg(long, value_enum, default_value = "rgba16f")]
+    pub texture_format: PsfTextureFormat,
+    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4.
+    #[arg(long, default_value_t = 1)]
+    pub merge_levels: u32,
+    /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    pub cache: Option<PathBuf>,
+    /// Compute kernels without reading or writing the cache.
+    #[arg(long)]
+    pub no_cache: bool,
+    /// Print the GPU time of each splatting pass.
+    #[arg(long)]
+    pub timings: bool,
+    /// Print a JSON summary to standard output.
+    #[arg(long)]
+    pub json: bool,
+    /// Exposure in EV for PNG output (linear values × 2^EV; 1.0 maps to white). Default: the
+    /// input frame's log-average luminance maps to middle grey.
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Tone mapping for PNG output.
+    #[arg(long, value_enum, default_value = "clamp")]
+    pub tonemap: TonemapArg,
+    /// Output image: .png (sRGB, tone-mapped) or .exr (linear).
+    #[arg(short, long, value_name = "FILE", default_value = "ocular.png")]
+    pub output: PathBuf,
+}
+
+fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
+    let (x, y) = text
+        .split_once(',')
+        .ok_or_else(|| format!("\"{text}\" is not X,Y"))?;
+    let x = x
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{x}\" is not a pixel column"))?;
+    let y = y
+        .trim()
+        .parse()
+        .map_err(|_| format!("\"{y}\" is not a pixel row"))?;
+    Ok((x, y))
+}
+
+/// A frame to render, from a scene or from files.
+struct Input {
+    width: u32,
+    height: u32,
+    color: Vec<[f32; 4]>,
+    depth_m: Vec<f32>,
+    fov_y_deg: f64,
+    focus_m: Option<f64>,
+    pupil_mm: Option<f64>,
+    luminance_cdm2: Option<f64>,
+    label: String,
+}
+
+fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
+    if let (Some(color_path), Some(depth_path)) = (&args.color, &args.depth) {
+        let color = image_io::read_exr_rgba(color_path)?;
+        let depth = image_io::read_exr_depth(depth_path)?;
+        if (color.width, color.height) != (depth.width, depth.height) {
+            return Err(Error::input(format!(
+                "--color is {}×{} but --depth is {}×{}; they must match",
+                color.width, color.height, depth.width, depth.height
+            )));
+        }
+        return Ok(Input {
+            width: color.width,
+            height: color.height,
+            color: color.pixels,
+            depth_m: depth.pixels,
+            fov_y_deg: args.fov_y.unwrap_or(60.0),
+            focus_m: None,
+            pupil_mm: None,
+            luminance_cdm2: None,
+            label: color_path.display().to_string(),
+        });
+    }
+    let _ = cli;
+    let name = args
+        .scene
+        .clone()
+        .unwrap_or_else(|| "primitives".to_string());
+    let scene = Scene::load(&name)?;
+    if !args.time.is_finite() || args.time < 0.0 {
+        return Err(Error::input(format!(
+            "--time {} must be a non-negative number of seconds",
+            args.time
+        )));
+    }
+    let state = scene.at_time(args.time);
+    let (width, height) = args.size.unwrap_or((640, 360));
+    let mut rasterizer = Rasterizer::new(ctx)?;
+    let frame = rasterizer.render(ctx, &state, width, height)?;
+    Ok(Input {
+        width,
+        height,
+        color: frame.color,
+        depth_m: frame.depth_m,
+        fov_y_deg: state.camera.fov_y_deg,
+        focus_m: Some(state.focus_m),
+        pupil_mm: state.pupil_mm,
+        luminance_cdm2: state.luminance_cd_m2,
+        label: format!("scene {name}"),
+    })
+}
+
+pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
+    if let Some(eye) = Eye::preset(spec) {
+        return Ok(eye);
+    }
+    let text = std::fs::read_to_string(spec).map_err(|e| {
+        Error::input(format!(
+            "--eye {spec}: not a preset ({}) and not a readable file ({e})",
+            crate::eye::presets::PRESET_NAMES.join(", ")
+        ))
+    })?;
+    Eye::from_toml_str(&text).map_err(|e| Error::file(spec, e))
+}
+
+fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
+    if let Some(text) = &args.focus_m {
+        let t = text.trim().to_ascii_lowercase();
+        if t == "inf" || t == "infinity" {
+            return Ok(0.0);
+        }
+        let m: f64 = t.parse().map_err(|_| {
+            Error::input(format!(
+                "--focus-m \"{text}\" is not a distance in metres or inf"
+            ))
+        })?;
+        if !(m.is_finite() && m > 0.0) {
+            return Err(Error::input(format!(
+                "--focus-m {m} must be a positive distance in metres (or inf)"
+            )));
+        }
+        return Ok(1.0 / m);
+    }
+    if let Some(d) = args.focus_d {
+        if !(d.is_finite() && d >= 0.0) {
+            return Err(Error::input(format!(
+                "--focus-d {d} must be a non-negative vergence in dioptres"
+            )));
+        }
+        return Ok(d);
+    }
+    let depth_at = |x: u32, y: u32| input.depth_m[(y * input.width + x) as usize];
+    if let Some((x, y)) = args.focus_at {
+        if x >= input.width || y >= input.height {
+            return Err(Error::input(format!(
+                "--focus-at {x},{y} is outside the {}×{} frame",
+                input.width, input.height
+            )));
+        }
+        return Ok(crate::render::reference::dioptre_of_depth(depth_at(x, y)));
+    }
+    if let Some(m) = input.focus_m {
+        return Ok(if m.is_finite() && m > 0.0 {
+            1.0 / m
+        } else {
+            0.0
+        });
+    }
+    Ok(crate::render::reference::dioptre_of_depth(depth_at(
+        input.width / 2,
+        input.height / 2,
+    )))
+}
+
+/// Mean luminance (cd/m²) of linear Rec.709 RGB.
+fn mean_luminance(color: &[[f32; 4]]) -> f64 {
+    let sum: f64 = color
+        .iter()
+        .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
+        .sum();
+    sum / color.len().max(1) as f64
+}
+
+fn pupil_diameter(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
+    if let Some(p) = args.pupil_mm {
+        if !(p.is_finite() && (1.0..=9.0).contains(&p)) {
+            return Err(Error::input(format!("--pupil-mm {p} is outside 1–9 mm")));
+        }
+        return Ok((p, "given".into()));
+    }
+    let (luminance, source) = if let Some(l) = args.luminance_cdm2 {
+        (l, "--luminance-cdm2")
+    } else if let Some(p) = input.pupil_mm {
+        return Ok((p, "scene".into()));
+    } else if let Some(l) = input.luminance_cdm2 {
+        (l, "scene luminance")
+    } else {
+        (mean_luminance(&input.color), "frame mean luminance")
+    };
+    if !(luminance.is_finite() && luminance >= 0.0) {
+        return Err(Error::input(format!(
+            "luminance {luminance} cd/m² must be a non-negative number"
+        )));
+    }
+    let aspect = f64::from(input.width) / f64::from(input.height);
+    let field_deg2 = input.fov_y_deg * input.fov_y_deg * aspect;
+    let (mm, model) = match args.pupil_model {
+        PupilModel::WatsonYellott => (
+            watson_yellott_mm(luminance, field_deg2, args.age, Viewing::OneEye),
+            "Watson–Yellott",
+        ),
+        PupilModel::MoonSpencer => (moon_spencer_mm(luminance), "Moon–Spencer"),
+    };
+    Ok((mm, format!("{model} at {luminance:.3} cd/m² ({source})")))
+}
+
+#[derive(serde::Serialize)]
+struct Summary {
+    output: String,
+    input: String,
+    eye: String,
+    width: u32,
+    height: u32,
+    fov_y_deg: f64,
+    focus_d: f64,
+    pupil_mm: f64,
+    pupil_source: String,
+    method: &'static str,
+    seconds_render: f64,
+    seconds_kernels: f64,
+    kernels_from_cache: bool,
+    psfs_computed: usize,
+    max_radius_px: u32,
+    gpu_ms: Option<Vec<(String, f64)>>,
+    gpu_total_ms: Option<f64>,
+    device: String,
+}
+
+pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
+    let output_ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(output_ext.as_deref(), Some("png") | Some("exr")) {
+        return Err(Error::input(format!(
+            "-o {}: the output must end in .png or .exr",
+            args.output.display()
+        )));
+    }
+    let splat = SplatSettings {
+        tile_size: args.tile_size,
+        texture_format: args.texture_format,
+        merge: MergeSettings {
+            levels: args.merge_levels,
+            ..MergeSettings::default()
+        },
+        ..SplatSettings::default()
+    };
+    splat
+        .validate()
+        .map_err(|e| Error::input(format!("--tile-size / --merge-levels: {e}")))?;
+    let eye = load_eye(&args.eye)?;
+    let ctx = Context::new(&cli.context_options())?;
+    let input = load_input(cli, args, &ctx)?;
+    if let Some(fov) = args.fov_y {
+        if !(fov.is_finite() && fov > 0.0 && fov < 180.0) {
+            return Err(Error::input(format!(
+                "--fov-y {fov} must lie in (0, 180) degrees"
+            )));
+        }
+    }
+    let focus_d = focus_dioptres(args, &input)?;
+    let (pupil_mm, pupil_source) = pupil_diameter(args, &input)?;
+    let state = EyeState { focus_d, pupil_mm };
+    let screen = Screen {
+        fov_y_deg: input.fov_y_deg,
+        height_px: input.height,
+    };
+    let needs = scene_needs(&[dioptre_range(&input.depth_m)], &[state], screen);
+    let mut options = KernelOptions::default();
+    if args.no_cache {
+        options.cache_dir = None;
+    } else if let Some(dir) = &args.cache {
+        options.cache_dir = Some(dir.clone());
+    }
+    let kernels = prepare_kernels(&eye, &needs, &options)?;
+    let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
+    let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
+    let seconds_kernels = kernels.seconds;
+    let max_radius = kernels.grid.max_radius_px;
+    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    let frame_input = FrameInput {
+        width: input.width,
+        height: input.height,
+        color: &input.color,
+        depth_m: &input.depth_m,
+    };
+    let frame = renderer.render(&frame_input, state, args.method)?;
+
+    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
+    if output_ext.as_deref() == Some("exr") {
+        image_io::write_exr_rgba(&args.output, &image)?;
+    } else {
+        let mode = match args.tonemap {
+            TonemapArg::Clamp => TonemapMode::Clamp,
+            TonemapArg::Reinhard => TonemapMode::Reinhard,
+        };
+        // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
+        let exposure_ev = args.exposure.unwrap_or_else(|| {
+            Tonemap::auto_exposure_ev(&ImageRgba::new(
+                input.width,
+                input.height,
+                input.color.clone(),
+            ))
+        });
+        image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })?;
+    }
+    let gpu: Option<Vec<(String, f64)>> = frame
+        .timings
+        .as_ref()
+        .map(|t| t.passes.iter().map(|p| (p.name.clone(), p.ms)).collect());
+    let summary = Summary {
+        output: args.output.display().to_string(),
+        input: input.label.clone(),
+        eye: args.eye.clone(),
+        width: input.width,
+        height: input.height,
+        fov_y_deg: input.fov_y_deg,
+        focus_d,
+        pupil_mm,
+        pupil_source,
+        method: args.method.name(),
+        seconds_render: frame.seconds,
+        seconds_kernels,
+        kernels_from_cache: from_cache,
+        psfs_computed: psfs,
+        max_radius_px: max_radius,
+        gpu_total_ms: frame.timings.as_ref().map(|t| t.total_ms()),
+        gpu_ms: gpu,
+        device: ctx.device_info().name.clone(),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary)
+                .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?
+        );
+        return Ok(());
+    }
+    let focus = if focus_d > 0.0 {
+        format!("{:.3} m", 1.0 / focus_d)
+    } else {
+        "infinity".into()
+    };
+    println!(
+        "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
+        summary.output,
+        input.width,
+        input.height,
+        input.label,
+        args.eye,
+        pupil_mm,
+        summary.pupil_source,
+        args.method.name(),
+        frame.seconds,
+        if from_cache { "from cache".to_string() } else { format!("{psfs} PSFs in {seconds_kernels:.1} s") }
+    );
+    if args.timings {
+        if let Some(t) = &frame.timings {
+            for p in &t.passes {
+                println!("  {:<12} {:>9.3} ms", p.name, p.ms);
+            }
+            println!(
+                "  {:<12} {:>9.3} ms  (GPU, {})",
+                "total",
+                t.total_ms(),
+                summary.device
+            );
+        } else {
+            println!("  (--timings applies to --method splat)");
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,516 @@
+//! `ocular video`: renders a scene's keyframed animation (or a focus sweep) frame by frame to
+//! numbered PNG or EXR files.
+//!
+//! - Resumable: frames are written to a temporary name and renamed, so a file with a final name
+//!   is complete; a re-run skips those and removes stale temporaries.
+//! - Splittable: kernels are planned from the whole animation (never from the requested range),
+//!   and every frame's eye state depends only on its own index, so `--frames 0..50` and
+//!   `--frames 50..100` produce byte-identical files to one run over `0..100`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+
+use super::raster::parse_size;
+use super::render::load_eye;
+use super::Cli;
+use crate::eye::Eye;
+use crate::gpu::Context;
+use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::optics::pupil::{watson_yellott_mm, Viewing};
+use crate::psf::axes::Screen;
+use crate::render::frame::{
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+};
+use crate::render::splat::{FrameInput, SplatSettings};
+use crate::render::{Frame, Rasterizer};
+use crate::scene::{FrameState, Scene};
+use crate::{Error, Result};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FrameFormat {
+    Png,
+    Exr,
+}
+
+#[derive(Debug, Args)]
+#[command(after_help = "Examples:\n  \
+    ocular video --scene colonnade --eye myopia --fps 30 -o frames/ --mp4 walk.mp4\n  \
+    ocular video --scene chart --eye healthy --side-by-side keratoconus -o cmp/\n  \
+    ocular video --scene primitives --eye healthy --focus-sweep 0.2..7.5 --duration 4 -o sweep/\n\n\
+Split a long export across machines with --frames A..B (frames A to B−1): each job writes its own \
+files into the same folder, and the union is identical to one run. See the README for Slurm, GNU \
+parallel and Kubernetes recipes.")]
+pub struct VideoArgs {
+    /// Built-in scene or a scene .toml file.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub scene: String,
+    /// Eye preset or eye .toml file.
+    #[arg(long, value_name = "NAME|FILE", default_value = "healthy")]
+    pub eye: String,
+    /// Frames per second.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Length in seconds (default: the scene's animation, or 2 s for a focus sweep).
+    #[arg(long, value_name = "SECONDS")]
+    pub duration: Option<f64>,
+    /// Frames to render: A..B renders A to B−1; A.. and ..B are open ends. Default: all.
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<String>,
+    /// Output folder (created if missing).
+    #[arg(short, long, value_name = "DIR")]
+    pub output: PathBuf,
+    /// Frame file format.
+    #[arg(long, value_enum, default_value = "png")]
+    pub format: FrameFormat,
+    /// Frame size (default 640x360).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Render every frame through this second eye as well, side by side and labelled.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub side_by_side: Option<String>,
+    /// Fixed camera (the scene at t = 0); focus moves from NEAR to FAR metres, linearly in
+    /// dioptres.
+    #[arg(long, value_name = "NEAR..FAR")]
+    pub focus_sweep: Option<String>,
+    /// Fixed pupil diameter in mm (default: the scene's pupil or luminance, else each frame's
+    /// mean luminance through the Watson–Yellott formula).
+    #[arg(long, value_name = "MM")]
+    pub pupil_mm: Option<f64>,
+    /// Also encode the frames to an MP4 with ffmpeg (needs ffmpeg on PATH; PNG frames).
+    #[arg(long, value_name = "FILE.mp4")]
+    pub mp4: Option<PathBuf>,
+    /// Exposure in EV for PNG frames (default: from frame 0's log-average luminance, then
+    /// fixed, so frames do not flicker and splits agree).
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Kernel cache folder; --no-cache disables it.
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    pub cache: Option<PathBuf>,
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+/// Parses `A..B`, `A..`, `..B` or `A` into a half-open range within `0..total`.
+pub fn parse_range(text: &str, total: usize) -> std::result::Result<(usize, usize), String> {
+    let text = text.trim();
+    let parse = |s: &str, default: usize| -> std::result::Result<usize, String> {
+        if s.is_empty() {
+            Ok(default)
+        } else {
+            s.parse::<usize>()
+                .map_err(|_| format!("\"{s}\" is not a frame number"))
+        }
+    };
+    let (a, b) = match text.split_once("..") {
+        Some((a, b)) => (parse(a, 0)?, parse(b, total)?),
+        None => {
+            let a = parse(text, 0)?;
+            (a, a + 1)
+        }
+    };
+    if a >= b {
+        return Err(format!(
+            "--frames {text}: the range is empty (A..B renders A to B−1)"
+        ));
+    }
+    if b > total {
+        return Err(format!(
+            "--frames {text}: the animation has {total} frames (0..{total})"
+        ));
+    }
+    Ok((a, b))
+}
+
+/// `NEAR..FAR` in metres.
+fn parse_sweep(text: &str) -> std::result::Result<(f64, f64), String> {
+    let (a, b) = text
+        .split_once("..")
+        .ok_or_else(|| format!("--focus-sweep \"{text}\" is not NEAR..FAR (metres)"))?;
+    let near: f64 = a
+        .trim()
+        .parse()
+        .map_err(|_| format!("--focus-sweep: \"{a}\" is not a distance in metres"))?;
+    let far: f64 = b
+        .trim()
+        .parse()
+        .map_err(|_| format!("--focus-sweep: \"{b}\" is not a distance in metres"))?;
+    if !(near.is_finite() && near > 0.0 && far > 0.0) {
+        return Err(format!(
+            "--focus-sweep {text}: distances must be positive metres (far may be inf)"
+        ));
+    }
+    Ok((near, far))
+}
+
+pub fn frame_name(index: usize, format: FrameFormat) -> String {
+    match format {
+        FrameFormat::Png => format!("frame_{index:06}.png"),
+        FrameFormat::Exr => format!("frame_{index:06}.exr"),
+    }
+}
+
+/// Everything that fixes frame `i`: the scene state and the eye state.
+struct Timeline {
+    scene: Scene,
+    fps: f64,
+    count: usize,
+    sweep: Option<(f64, f64)>,
+}
+
+impl Timeline {
+    fn state(&self, index: usize) -> FrameState<'_> {
+        let t = if self.sweep.is_some() {
+            0.0
+        } else {
+            index as f64 / self.fps
+        };
+        self.scene.at_time(t)
+    }
+
+    fn focus_d(&self, index: usize, state: &FrameState<'_>) -> f64 {
+        match self.sweep {
+            Some((near, far)) => {
+                let (dn, df) = (1.0 / near, if far.is_finite() { 1.0 / far } else { 0.0 });
+                let t = if self.count > 1 {
+                    index as f64 / (self.count - 1) as f64
+                } else {
+                    0.0
+                };
+                dn + (df - dn) * t
+            }
+            None => {
+                if state.focus_m.is_finite() && state.focus_m > 0.0 {
+                    1.0 / state.focus_m
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+}
+
+fn pupil_for(args: &VideoArgs, state: &FrameState<'_>, frame: &Frame, fov_y_deg: f64) -> f64 {
+    if let Some(p) = args.pupil_mm.or(state.pupil_mm) {
+        return p;
+    }
+    let luminance = state.luminance_cd_m2.unwrap_or_else(|| {
+        let sum: f64 = frame
+            .color
+            .iter()
+            .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
+            .sum();
+        sum / frame.color.len().max(1) as f64
+    });
+    let aspect = f64::from(frame.width) / f64::from(frame.height);
+    watson_yellott_mm(
+        luminance,
+        fov_y_deg * fov_y_deg * aspect,
+        30.0,
+        Viewing::OneEye,
+    )
+    .clamp(1.5, 8.0)
+}
+
+/// Frames sampled for planning the kernels: evenly spread, first and last included.
+fn planning_frames(count: usize) -> Vec<usize> {
+    const MAX: usize = 48;
+    if count <= MAX {
+        return (0..count).collect();
+    }
+    (0..MAX).map(|k| k * (count - 1) / (MAX - 1)).collect()
+}
+
+pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
+        return Err(Error::input(format!(
+            "--fps {} must lie in (0, 1000]",
+            args.fps
+        )));
+    }
+    if let Some(p) = args.pupil_mm {
+        if !(1.0..=9.0).contains(&p) {
+            return Err(Error::input(format!("--pupil-mm {p} is outside 1–9 mm")));
+        }
+    }
+    if args.mp4.is_some() && args.format != FrameFormat::Png {
+        return Err(Error::input("--mp4 needs --format png frames"));
+    }
+    let sweep = args
+        .focus_sweep
+        .as_deref()
+        .map(parse_sweep)
+        .transpose()
+        .map_err(Error::input)?;
+    let scene = Scene::load(&args.scene)?;
+    let duration = args.duration.unwrap_or(if sweep.is_some() {
+        2.0
+    } else {
+        scene.duration_s()
+    });
+    if !(duration.is_finite() && duration >= 0.0) {
+        return Err(Error::input(format!(
+            "--duration {duration} must be a non-negative number of seconds"
+        )));
+    }
+    let count = ((duration * args.fps).round() as usize).max(1);
+    let (first, end) = match &args.frames {
+        Some(text) => parse_range(text, count).map_err(Error::input)?,
+        None => (0, count),
+    };
+    let eyes: Vec<(String, Eye)> = std::iter::once(args.eye.clone())
+        .chain(args.side_by_side.clone())
+        .map(|spec| load_eye(&spec).map(|e| (spec, e)))
+        .collect::<Result<_>>()?;
+    std::fs::create_dir_all(&args.output).map_err(|e| {
+        Error::file(
+            &args.output,
+            format!("cannot create the output folder: {e}"),
+        )
+    })?;
+    probe_writable(&args.output)?;
+    remove_stale_temporaries(&args.output);
+
+    let timeline = Timeline {
+        scene,
+        fps: args.fps,
+        count,
+        sweep,
+    };
+    let ctx = Context::new(&cli.context_options())?;
+    let (width, height) = args.size.unwrap_or((640, 360));
+    let mut rasterizer = Rasterizer::new(&ctx)?;
+    let fov_y_deg = timeline.state(0).camera.fov_y_deg;
+    let screen = Screen {
+        fov_y_deg,
+        height_px: height,
+    };
+
+    // Plan from the whole animation so that any split renders identical frames.
+    let mut ranges = Vec::new();
+    let mut states = Vec::new();
+    let mut exposure_ev = args.exposure;
+    for i in planning_frames(count) {
+        let state = timeline.state(i);
+        let frame = rasterizer.render(&ctx, &state, width, height)?;
+        if exposure_ev.is_none() {
+            exposure_ev = Some(Tonemap::auto_exposure_ev(&ImageRgba::new(
+                width,
+                height,
+                frame.color.clone(),
+            )));
+        }
+        ranges.push(dioptre_range(&frame.depth_m));
+        states.push(EyeState {
+            focus_d: timeline.focus_d(i, &state),
+            pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
+        });
+    }
+    let needs = scene_needs(&ranges, &states, screen);
+    let mut options = KernelOptions::default();
+    if args.no_cache {
+        options.cache_dir = None;
+    } else if let Some(dir) = &args.cache {
+        options.cache_dir = Some(dir.clone());
+    }
+    let mut renderers = Vec::new();
+    for (_, eye) in &eyes {
+        let kernels = prepare_kernels(eye, &needs, &options)?;
+        renderers.push(FrameRenderer::new(
+            &ctx,
+            eye.clone(),
+            kernels,
+            options.settings.clone(),
+            SplatSettings::default(),
+        ));
+    }
+
+    let todo: Vec<usize> = (first..end)
+        .filter(|&i| !args.output.join(frame_name(i, args.format)).exists())
+        .collect();
+    let skipped = (end - first) - todo.len();
+    let bar = progress_bar(todo.len() as u64);
+    let started = Instant::now();
+    for &i in &todo {
+        let state = timeline.state(i);
+        let frame = rasterizer.render(&ctx, &state, width, height)?;
+        let eye_state = EyeState {
+            focus_d: timeline.focus_d(i, &state),
+            pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
+        };
+        let input = FrameInput {
+            width,
+            height,
+            color: &frame.color,
+            depth_m: &frame.depth_m,
+        };
+        let mut panels = Vec::new();
+        for renderer in renderers.iter_mut() {
+            panels.push(renderer.render(&input, eye_state, Method::Splat)?.color);
+        }
+        let labels: Vec<&str> = eyes.iter().map(|(name, _)| name.as_str()).collect();
+        let image = compose(
+            width,
+            height,
+            &panels,
+            if panels.len() > 1 {
+                Some(&labels)
+            } else {
+                None
+            },
+        );
+        let path = args.output.join(frame_name(i, args.format));
+        match args.format {
+            FrameFormat::Png => image_io::write_png(
+                &path,
+                &image,
+                Tonemap {
+                    exposure_ev: exposure_ev.unwrap_or(0.0),
+                    mode: TonemapMode::Clamp,
+                },
+            )?,
+            FrameFormat::Exr => image_io::write_exr_rgba(&path, &image)?,
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let seconds = started.elapsed().as_secs_f64();
+    println!(
+        "frames {first}..{end} of {count}: rendered {}, skipped {skipped} already complete, in {seconds:.1} s ({:.2} frames/s) → {}",
+        todo.len(),
+        todo.len() as f64 / seconds.max(1e-9),
+        args.output.display()
+    );
+    if let Some(mp4) = &args.mp4 {
+        encode_mp4(&args.output, args.fps, mp4)?;
+    }
+    Ok(())
+}
+
+fn progress_bar(total: u64) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "frames [{bar:30}] {pos}/{len} {per_sec} ETA {eta}",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar
+}
+
+fn probe_writable(dir: &Path) -> Result<()> {
+    let probe = dir.join(format!(".ocular-write-test-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| Error::file(dir, format!("the output folder is not writable: {e}")))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+/// Temporaries left by an interrupted run (`NAME.tmp-PID`) are never valid frames.
+fn remove_stale_temporaries(dir: &Path) {
+    if let Ok(entries) = std::fs::read_dir(dir) {
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.starts_with("frame_") && name.contains(".tmp-") {
+                let _ = std::fs::remove_file(entry.path());
+            }
+        }
+    }
+}
+
+/// Panels side by side; labels drawn in the top-left corner of each panel.
+fn compose(
+    width: u32,
+    height: u32,
+    panels: &[Vec<[f32; 4]>],
+    labels: Option<&[&str]>,
+) -> ImageRgba {
+    let n = panels.len() as u32;
+    let mut pixels = vec![[0.0f32, 0.0, 0.0, 1.0]; (width * n * height) as usize];
+    for (k, panel) in panels.iter().enumerate() {
+        for y in 0..height {
+            for x in 0..width {
+                pixels[(y * width * n + k as u32 * width + x) as usize] =
+                    panel[(y * width + x) as usize];
+            }
+        }
+    }
+    let mut image = ImageRgba::new(width * n, height, pixels);
+    if let Some(labels) = labels {
+        for (k, label) in labels.iter().enumerate() {
+            crate::psf::preview::draw_label(&mut image, k as u32 * width + 6, 6, label);
+        }
+    }
+    image
+}
+
+fn encode_mp4(dir: &Path, fps: f64, mp4: &Path) -> Result<()> {
+    let found = std::env::var_os("PATH")
+        .map(|paths| std::env::split_paths(&paths).any(|p| p.join("ffmpeg").is_file()))
+        .unwrap_or(false);
+    if !found {
+        return Err(Error::input(format!(
+            "--mp4 {}: ffmpeg is not on PATH (Debian/Ubuntu: apt-get install ffmpeg); the frames are in {}",
+            mp4.display(),
+            dir.display()
+        )));
+    }
+    let status = std::process::Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-framerate"])
+        .arg(format!("{fps}"))
+        .arg("-i")
+        .arg(dir.join("frame_%06d.png"))
+        .args([
+            "-c:v",
+            "libx264",
+            "-pix_fmt",
+            "yuv420p",
+            "-vf",
+            "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+        ])
+        .arg(mp4)
+        .status()
+        .map_err(|e| Error::file(mp4, format!("cannot run ffmpeg: {e}")))?;
+    if !status.success() {
+        return Err(Error::file(
+            mp4,
+            format!(
+                "ffmpeg failed ({status}); the frames are in {}",
+                dir.display()
+            ),
+        ));
+    }
+    println!("wrote {}", mp4.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_are_half_open_and_checked() {
+        assert_eq!(parse_range("2..5", 10), Ok((2, 5)));
+        assert_eq!(parse_range("..3", 10), Ok((0, 3)));
+        assert_eq!(parse_range("7..", 10), Ok((7, 10)));
+        assert_eq!(parse_range("4", 10), Ok((4, 5)));
+        assert!(parse_range("5..5", 10).is_err());
+        assert!(parse_range("3..11", 10)
+            .unwrap_err()
+            .contains("has 10 frames"));
+        assert!(parse_range("a..3", 10).is_err());
+    }
+
+    #[test]
+    fn planning_samples_cover_both_ends() {
+        let p = planning_frames(1000);
+        assert_eq!((p[0], *p.last().unwrap()), (0, 999));
+        assert_eq!(planning_frames(5), vec![0, 1, 2, 3, 4]);
+    }
+}

@@ -1,0 +1,285 @@
+//! One frame from start to finish: what the frame needs from the eye (planned and cached
+//! kernels), and one of the three rendering methods over a colour + depth input. The CLI's
+//! `render`, `compare`, `video` and `bench` all go through here.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use crate::eye::Eye;
+use crate::gpu::{Context, Timings};
+use crate::psf::axes::{GridAxes, KernelSettings, Screen};
+use crate::psf::cache::{self, CacheOutcome};
+use crate::psf::exact::ExactEye;
+use crate::psf::grid::{compute_grid, GridReport, Stage};
+use crate::psf::kernels::KernelGrid;
+use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
+use crate::render::reference::dioptre_of_depth;
+use crate::render::splat::{FrameInput, SplatSettings, SplatStats, Splatter, ViewState};
+use crate::render::{reference, slices};
+use crate::{Error, Result};
+
+/// How a frame is rendered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// Tiled PSF splatting on the GPU (the product).
+    Splat,
+    /// Exact per-pixel PSFs on the CPU (the ground truth; slow).
+    Reference,
+    /// Depth slices convolved with their centre PSF (the classic previous method).
+    Slices,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Splat => "splat",
+            Method::Reference => "reference",
+            Method::Slices => "slices",
+        }
+    }
+}
+
+/// The eye's state for one frame: where it focuses and how wide its pupil is.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EyeState {
+    pub focus_d: f64,
+    pub pupil_mm: f64,
+}
+
+/// Where kernels come from and how they are computed.
+#[derive(Clone, Debug)]
+pub struct KernelOptions {
+    pub settings: KernelSettings,
+    /// The grid whose spacing planned axes follow (the seed paper's by default).
+    pub reference_axes: GridAxes,
+    /// None: no cache.
+    pub cache_dir: Option<PathBuf>,
+    /// Show a progress bar on a terminal.
+    pub progress: bool,
+}
+
+impl Default for KernelOptions {
+    fn default() -> Self {
+        KernelOptions {
+            settings: KernelSettings::default(),
+            reference_axes: GridAxes::default(),
+            cache_dir: cache::default_cache_dir(),
+            progress: true,
+        }
+    }
+}
+
+/// Kernels for a set of frames, with how they were obtained.
+pub struct PreparedKernels {
+    pub grid: KernelGrid,
+    pub plan: Plan,
+    /// None when loaded from the cache.
+    pub report: Option<GridReport>,
+    pub cache: CacheOutcome,
+    pub seconds: f64,
+}
+
+/// Smallest and largest object vergence of a depth buffer (infinity = 0 D).
+pub fn dioptre_range(depth_m: &[f32]) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for &d in depth_m {
+        let v = dioptre_of_depth(d);
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        (0.0, 0.0)
+    } else {
+        (lo, hi)
+    }
+}
+
+/// What frames with these depth ranges and eye states need, on this screen.
+pub fn scene_needs(ranges: &[(f64, f64)], states: &[EyeState], screen: Screen) -> SceneNeeds {
+    let lo = ranges.iter().map(|r| r.0).fold(f64::INFINITY, f64::min);
+    let hi = ranges.iter().map(|r| r.1).fold(0.0, f64::max);
+    let mut focus: Vec<f64> = states.iter().map(|s| s.focus_d).collect();
+    let mut pupils: Vec<f64> = states.iter().map(|s| s.pupil_mm).collect();
+    for v in [&mut focus, &mut pupils] {
+        v.sort_by(f64::total_cmp);
+        v.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    }
+    SceneNeeds {
+        dioptre_min: if lo.is_finite() { lo } else { 0.0 },
+        dioptre_max: hi,
+        focus_d: focus,
+        pupils_mm: pupils,
+        screen,
+    }
+}
+
+/// Plans, then loads or computes (and caches) the kernels `needs` calls for.
+pub fn prepare_kernels(
+    eye: &Eye,
+    needs: &SceneNeeds,
+    options: &KernelOptions,
+) -> Result<PreparedKernels> {
+    let started = Instant::now();
+    let plan = plan_for_scene(needs, &options.reference_axes).map_err(Error::input)?;
+    let key = cache::grid_key(eye, &plan.axes, &plan.screen, &options.settings);
+    let bar = options.progress.then(|| progress_bar(plan.psfs));
+    let progress = |stage: Stage, done: usize, total: usize| {
+        if let Some(bar) = &bar {
+            let label = match stage {
+                Stage::Optics => "eye optics",
+                Stage::Psfs => "PSFs",
+                Stage::Kernels => "kernels",
+            };
+            bar.set_message(label);
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+    };
+    let (grid, report, outcome) = cache::cached(options.cache_dir.as_deref(), &key, || {
+        compute_grid(eye, &plan.axes, &plan.screen, &options.settings, &progress)
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    match &outcome {
+        CacheOutcome::Stored {
+            warning: Some(w), ..
+        } => eprintln!("warning: {w}"),
+        CacheOutcome::WriteFailed(w) => eprintln!("warning: kernels not cached: {w}"),
+        _ => {}
+    }
+    Ok(PreparedKernels {
+        grid,
+        plan,
+        report,
+        cache: outcome,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+fn progress_bar(total: usize) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} ETA {eta}")
+            .expect("static template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// A rendered frame and what it cost.
+pub struct RenderedFrame {
+    pub color: Vec<[f32; 4]>,
+    pub method: Method,
+    /// Wall-clock seconds for the method (upload and read-back included for the GPU).
+    pub seconds: f64,
+    /// GPU time per pass (splat only).
+    pub timings: Option<Timings>,
+    pub stats: Option<SplatStats>,
+}
+
+/// Renders frames through one eye's prepared kernels with any method.
+pub struct FrameRenderer {
+    ctx: Context,
+    eye: Eye,
+    kernels: PreparedKernels,
+    settings: KernelSettings,
+    splat_settings: SplatSettings,
+    splatter: Option<Splatter>,
+    pub slice_count: usize,
+}
+
+impl FrameRenderer {
+    pub fn new(
+        ctx: &Context,
+        eye: Eye,
+        kernels: PreparedKernels,
+        settings: KernelSettings,
+        splat_settings: SplatSettings,
+    ) -> FrameRenderer {
+        FrameRenderer {
+            ctx: ctx.clone(),
+            eye,
+            kernels,
+            settings,
+            splat_settings,
+            splatter: None,
+            slice_count: slices::DEFAULT_SLICES,
+        }
+    }
+
+    pub fn kernels(&self) -> &PreparedKernels {
+        &self.kernels
+    }
+
+    pub fn render(
+        &mut self,
+        input: &FrameInput<'_>,
+        state: EyeState,
+        method: Method,
+    ) -> Result<RenderedFrame> {
+        let screen = self.kernels.plan.screen;
+        if input.height != screen.height_px {
+            return Err(Error::input(format!(
+                "frame height {} differs from the {} px the kernels were projected for",
+                input.height, screen.height_px
+            )));
+        }
+        let started = Instant::now();
+        match method {
+            Method::Splat => {
+                if self.splatter.is_none() {
+                    self.splatter = Some(Splatter::new(
+                        &self.ctx,
+                        self.kernels.grid.clone(),
+                        self.splat_settings,
+                    )?);
+                }
+                let splatter = self.splatter.as_mut().expect("just created");
+                let out = splatter.render(
+                    input,
+                    ViewState {
+                        pupil_mm: state.pupil_mm,
+                        focus_d: state.focus_d,
+                    },
+                    false,
+                )?;
+                Ok(RenderedFrame {
+                    color: out.color,
+                    method,
+                    seconds: started.elapsed().as_secs_f64(),
+                    timings: Some(out.timings),
+                    stats: Some(out.stats),
+                })
+            }
+            Method::Reference | Method::Slices => {
+                let exact = ExactEye::new(
+                    &self.eye,
+                    state.pupil_mm,
+                    state.focus_d,
+                    self.kernels.grid.wavelengths_nm,
+                    screen,
+                    self.settings.clone(),
+                    self.kernels.grid.max_radius_px,
+                )?;
+                let color = if method == Method::Reference {
+                    reference::render(input, &exact)
+                } else {
+                    slices::render(input, &exact, self.slice_count)
+                };
+                Ok(RenderedFrame {
+                    color,
+                    method,
+                    seconds: started.elapsed().as_secs_f64(),
+                    timings: None,
+                    stats: None,
+                })
+            }
+        }
+    }
+}
