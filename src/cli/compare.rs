@@ -25,8 +25,9 @@ use crate::{Error, Result};
 #[command(after_help = "Examples:\n  \
     ocular compare --scene primitives --eye myopia --size 320x180\n  \
     ocular compare --scene primitives --eye keratoconus --json kc.json --maps maps/\n\n\
-Quality is measured against the ground truth on the linear image clamped to [0, 1] (PSNR with a \
-peak of 1; SSIM with Wang et al.'s settings). The ground truth computes one exact PSF per 0.001 D \
+Quality is measured against the ground truth on the displayed image: linear values at the input \
+frame's automatic exposure, clamped to [0, 1] (PSNR with a peak of 1; SSIM with Wang et al.'s \
+settings; in JSON a PSNR of null means identical images). The ground truth computes one exact PSF per 0.001 D \
 bin and channel, on the CPU: it is slow by design.")]
 pub struct CompareArgs {
     #[arg(long, value_name = "NAME|FILE", default_value = "primitives")]
@@ -81,17 +82,12 @@ struct Report {
     methods: Vec<MethodResult>,
 }
 
-fn clamp01(image: &[[f32; 4]]) -> Vec<[f32; 4]> {
+/// The displayed image: linear values scaled by the exposure, clamped to [0, 1].
+fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
     image
         .iter()
-        .map(|p| {
-            [
-                p[0].clamp(0.0, 1.0),
-                p[1].clamp(0.0, 1.0),
-                p[2].clamp(0.0, 1.0),
-                1.0,
-            ]
-        })
+        .map(|p| [0, 1, 2].map(|c| (p[c] * scale).clamp(0.0, 1.0)))
+        .map(|v| [v[0], v[1], v[2], 1.0])
         .collect()
 }
 
@@ -160,11 +156,15 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let slices_frame = renderer.render(&input, eye_state, Method::Slices)?;
 
     let (w, h) = (width as usize, height as usize);
-    let truth01 = clamp01(&truth.color);
+    // Compare what a person sees: every image at the input frame's automatic exposure.
+    let exposure_ev =
+        Tonemap::auto_exposure_ev(&ImageRgba::new(width, height, frame.color.clone()));
+    let scale = 2f32.powf(exposure_ev);
+    let truth01 = exposed(&truth.color, scale);
     let mut methods = Vec::new();
     let mut maps = Vec::new();
     for frame in [&truth, &splat_frame, &slices_frame] {
-        let image = clamp01(&frame.color);
+        let image = exposed(&frame.color, scale);
         let quality = ssim(
             ImageView::new(w, h, &image),
             ImageView::new(w, h, &truth01),

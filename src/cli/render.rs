@@ -53,7 +53,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
     /// Focus distance in metres (`inf` for infinity).
-    #[arg(long, value_name = "M", conflicts_with_all = ["focus_d", "focus_at"])]
+    #[arg(long, value_name = "M", conflicts_with_all = ["focus_d", "focus_at"], allow_hyphen_values = true)]
     pub focus_m: Option<String>,
     /// Focus vergence in dioptres (0 = infinity).
     #[arg(

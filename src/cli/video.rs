@@ -100,7 +100,7 @@ pub fn parse_range(text: &str, total: usize) -> std::result::Result<(usize, usiz
             Ok(default)
         } else {
             s.parse::<usize>()
-                .map_err(|_| format!("\"{s}\" is not a frame number"))
+                .map_err(|_| format!("--frames {text}: \"{s}\" is not a frame number"))
         }
     };
     let (a, b) = match text.split_once("..") {

@@ -1,0 +1,373 @@
+//! The front doors end to end on lavapipe with tiny frames: `render`, `video` (resume after a
+//! kill, byte-identical splits, bad ranges), `bench` (JSON a script can read) and `compare`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn ocular() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_ocular"));
+    c.stdin(Stdio::null());
+    c
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ocular-frontdoors-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A kernel cache shared by the tests of this file (they plan the same small grids).
+fn cache() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ocular-frontdoors-cache-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{:?} failed:\n{}",
+        cmd,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let decoder = image::ImageReader::open(path)
+        .unwrap()
+        .with_guessed_format()
+        .unwrap();
+    let img = decoder
+        .decode()
+        .unwrap_or_else(|e| panic!("{} does not decode: {e}", path.display()));
+    (img.width(), img.height())
+}
+
+#[test]
+fn render_writes_the_picture_and_reports_json() {
+    let dir = temp_dir("render");
+    let out = dir.join("frame.png");
+    let json = run_ok(
+        ocular()
+            .args([
+                "render", "--size", "160x90", "--eye", "navarro", "--json", "--cache",
+            ])
+            .arg(cache())
+            .arg("-o")
+            .arg(&out),
+    );
+    assert_eq!(png_size(&out), (160, 90));
+    let summary: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(summary["method"], "splat");
+    assert!(
+        (summary["focus_d"].as_f64().unwrap() - 1.0 / 7.5).abs() < 1e-9,
+        "primitives focuses at 7.5 m"
+    );
+    let pupil = summary["pupil_mm"].as_f64().unwrap();
+    assert!((1.5..=8.0).contains(&pupil), "{pupil}");
+    assert!(summary["gpu_total_ms"].as_f64().unwrap() > 0.0);
+
+    // EXR output is linear and finite.
+    let exr = dir.join("frame.exr");
+    run_ok(
+        ocular()
+            .args([
+                "render",
+                "--size",
+                "160x90",
+                "--eye",
+                "navarro",
+                "--focus-at",
+                "80,45",
+                "--pupil-mm",
+                "4",
+                "--cache",
+            ])
+            .arg(cache())
+            .arg("-o")
+            .arg(&exr),
+    );
+    let image = ocular::image_io::read_exr_rgba(&exr).unwrap();
+    assert!(image.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())));
+}
+
+#[test]
+fn render_refuses_bad_input_with_exit_2_and_no_file() {
+    let dir = temp_dir("render-bad");
+    let out = dir.join("x.png");
+    let cases: [&[&str]; 6] = [
+        &["--focus-m", "-1"],
+        &["--eye", "no-such-eye"],
+        &["--pupil-mm", "12"],
+        &["--focus-at", "5000,1"],
+        &["--tile-size", "12"],
+        &["--scene", "no-such-scene"],
+    ];
+    for case in cases {
+        let output = ocular()
+            .args(["render", "--size", "64x36"])
+            .args(case)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{case:?}: {stderr}");
+        assert!(
+            stderr.starts_with("error:") && stderr.trim().lines().count() == 1,
+            "{case:?}: {stderr}"
+        );
+        assert!(!out.exists(), "{case:?} wrote a file");
+    }
+    let output = ocular()
+        .args(["render", "-o"])
+        .arg(dir.join("x.bmp"))
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+}
+
+fn video(dir: &Path, extra: &[&str]) -> Command {
+    let mut cmd = ocular();
+    cmd.args([
+        "video",
+        "--scene",
+        "primitives",
+        "--eye",
+        "navarro",
+        "--size",
+        "160x90",
+        "--focus-sweep",
+        "0.25..7.5",
+        "--duration",
+        "1",
+        "--fps",
+        "10",
+        "--cache",
+    ])
+    .arg(cache())
+    .arg("-o")
+    .arg(dir)
+    .args(extra);
+    cmd
+}
+
+fn frames_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("frame_"))
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn video_resumes_after_a_kill_and_splits_identically() {
+    // One run of all ten frames.
+    let whole = temp_dir("video-whole");
+    run_ok(&mut video(&whole, &[]));
+    let names = frames_in(&whole);
+    assert_eq!(names.len(), 10, "{names:?}");
+    assert!(names
+        .iter()
+        .all(|n| n.ends_with(".png") && !n.contains(".tmp-")));
+
+    // The same frames in two jobs give byte-identical files.
+    let split = temp_dir("video-split");
+    run_ok(&mut video(&split, &["--frames", "0..4"]));
+    run_ok(&mut video(&split, &["--frames", "4.."]));
+    for name in &names {
+        assert_eq!(
+            std::fs::read(whole.join(name)).unwrap(),
+            std::fs::read(split.join(name)).unwrap(),
+            "{name} differs"
+        );
+    }
+
+    // Kill a run part-way; complete frames stay, the rerun adds only the missing ones.
+    let resumed = temp_dir("video-resume");
+    let mut child = video(&resumed, &[])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while frames_in(&resumed)
+        .iter()
+        .filter(|n| n.ends_with(".png"))
+        .count()
+        < 3
+        && started.elapsed() < Duration::from_secs(300)
+    {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done_before: Vec<String> = frames_in(&resumed)
+        .into_iter()
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    assert!(!done_before.is_empty());
+    for name in &done_before {
+        // Every file with a final name is a complete frame.
+        assert_eq!(png_size(&resumed.join(name)), (160, 90));
+    }
+    let modified: Vec<_> = done_before
+        .iter()
+        .map(|n| {
+            std::fs::metadata(resumed.join(n))
+                .unwrap()
+                .modified()
+                .unwrap()
+        })
+        .collect();
+    let report = run_ok(&mut video(&resumed, &[]));
+    assert!(
+        report.contains(&format!("skipped {}", done_before.len())),
+        "{report}"
+    );
+    assert_eq!(frames_in(&resumed), names, "no temporaries may remain");
+    for (name, before) in done_before.iter().zip(modified) {
+        assert_eq!(
+            std::fs::metadata(resumed.join(name))
+                .unwrap()
+                .modified()
+                .unwrap(),
+            before,
+            "{name} was rewritten"
+        );
+        assert_eq!(
+            std::fs::read(whole.join(name)).unwrap(),
+            std::fs::read(resumed.join(name)).unwrap()
+        );
+    }
+}
+
+#[test]
+fn video_refuses_bad_ranges_and_unwritable_folders() {
+    let dir = temp_dir("video-bad");
+    for range in ["5..3", "0..11", "x..2"] {
+        let out = video(&dir, &["--frames", range]).output().unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{range}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--frames"));
+    }
+    let file = dir.join("not-a-folder");
+    std::fs::write(&file, b"x").unwrap();
+    let out = video(&file, &[]).output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(frames_in(&dir).is_empty());
+}
+
+#[test]
+fn bench_reports_every_pass_and_totals_that_add_up() {
+    let dir = temp_dir("bench");
+    let json = dir.join("bench.json");
+    run_ok(
+        ocular()
+            .args([
+                "bench", "--size", "160x90", "--eye", "navarro", "--warmup", "1", "--frames", "3",
+                "--cache",
+            ])
+            .arg(cache())
+            .arg("--json")
+            .arg(&json),
+    );
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let passes = report["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    for want in [
+        "psf texture",
+        "fragments",
+        "tile count",
+        "prefix sum",
+        "tile fill",
+        "tile sort",
+        "convolve",
+    ] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    // The total of each frame is the sum of its passes, so the means add up exactly.
+    let sum: f64 = passes.iter().map(|p| p["mean_ms"].as_f64().unwrap()).sum();
+    let total = report["total"]["mean_ms"].as_f64().unwrap();
+    assert!(
+        (sum - total).abs() <= 1e-6 * total.max(1.0),
+        "{sum} vs {total}"
+    );
+    for p in passes {
+        let (mean, median, p95) = (
+            p["mean_ms"].as_f64().unwrap(),
+            p["median_ms"].as_f64().unwrap(),
+            p["p95_ms"].as_f64().unwrap(),
+        );
+        assert!(mean >= 0.0 && median >= 0.0 && p95 >= median, "{p}");
+    }
+    assert_eq!(report["frames"], 3);
+    assert!(report["device"].as_str().is_some_and(|d| !d.is_empty()));
+}
+
+#[test]
+fn compare_reports_quality_and_writes_maps() {
+    let dir = temp_dir("compare");
+    let json = dir.join("compare.json");
+    run_ok(
+        ocular()
+            .args(["compare", "--size", "128x72", "--eye", "navarro", "--cache"])
+            .arg(cache())
+            .arg("--json")
+            .arg(&json)
+            .arg("--maps")
+            .arg(dir.join("maps")),
+    );
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let method = |name: &str| {
+        report["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == name)
+            .unwrap()
+            .clone()
+    };
+    // At this size the blur is a pixel or two, where every method is close to the truth; the
+    // ranking under strong blur is asserted in tests/slices.rs.
+    let (truth, splat, slices) = (method("reference"), method("splat"), method("slices"));
+    assert!(
+        truth["psnr_db"].is_null(),
+        "the truth against itself is identical: {truth}"
+    );
+    assert_eq!(truth["mssim"].as_f64(), Some(1.0));
+    assert!(splat["mssim"].as_f64().unwrap() >= 0.99, "{splat}");
+    for m in [&splat, &slices] {
+        let db = m["psnr_db"].as_f64().unwrap_or(f64::INFINITY);
+        assert!(db > 30.0, "{m}");
+        assert!(
+            m["seconds"].as_f64().unwrap() > 0.0
+                && m["speedup_vs_reference"].as_f64().unwrap() > 0.0
+        );
+    }
+    for f in [
+        "truth.png",
+        "splat.png",
+        "slices.png",
+        "ssim_splat.png",
+        "ssim_slices.png",
+    ] {
+        assert_eq!(png_size(&dir.join("maps").join(f)), (128, 72), "{f}");
+    }
+}
