@@ -6,6 +6,8 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod devices;
+mod eye;
+mod eye_plot;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -31,6 +33,8 @@ pub struct Cli {
 pub enum Command {
     /// List the Vulkan devices and mark the one ocular would use.
     Devices(devices::DevicesArgs),
+    /// Eyes: estimate one from a wavefront or prescription, show, measure, draw, list presets.
+    Eye(Box<eye::EyeArgs>),
 }
 
 impl Cli {
@@ -45,5 +49,29 @@ impl Cli {
 pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Devices(args) => devices::run(&cli, args),
+        Command::Eye(args) => eye::run(args),
     }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
+/// reader never sees a partial file and a failed run leaves no file behind.
+pub(crate) fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| crate::Error::input(format!("{}: not a file name", path.display())))?;
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = std::fs::write(&tmp, bytes).and_then(|_| std::fs::rename(&tmp, path));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(crate::Error::file(path, format!("cannot write: {e}")));
+    }
+    Ok(())
 }
