@@ -107,7 +107,7 @@ pub struct MeasureArgs {
     #[arg(long)]
     pub wavelength_nm: f64,
     /// Distance the eye focuses on, and where the measured object point sits (m or "inf").
-    #[arg(long, default_value = "inf")]
+    #[arg(long, default_value = "inf", allow_hyphen_values = true)]
     pub focus_m: String,
     /// Highest Zernike order (1–10).
     #[arg(long, default_value_t = 6)]
@@ -127,7 +127,7 @@ pub struct DrawArgs {
     #[arg(long, default_value_t = 555.0)]
     pub wavelength_nm: f64,
     /// Focus distances of the two panels (m or "inf").
-    #[arg(long, num_args = 1.., default_values = ["inf", "0.2"])]
+    #[arg(long, num_args = 1.., default_values = ["inf", "0.2"], allow_hyphen_values = true)]
     pub focus_m: Vec<String>,
 }
 

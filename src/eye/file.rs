@@ -44,17 +44,13 @@ const ESTIMATED: [(&str, &str); 4] = [
 
 /// Names of every eye preset: the built-in structures and the estimated eyes.
 pub fn preset_names() -> Vec<&'static str> {
-    super::presets::PRESET_NAMES
-        .iter()
-        .copied()
-        .chain(ESTIMATED.iter().map(|e| e.0))
-        .collect()
+    super::presets::PRESET_NAMES.to_vec()
 }
 
 /// An eye preset by name (case-insensitive), with its estimate record where it has one.
 pub fn preset(name: &str) -> Option<EyeFile> {
     let key = name.trim().to_ascii_lowercase();
-    if let Some(eye) = Eye::preset(&key) {
+    if let Some(eye) = super::presets::builtin_preset(&key) {
         return Some(EyeFile {
             eye,
             estimate: None,

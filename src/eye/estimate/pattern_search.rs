@@ -155,7 +155,11 @@ where
         }
         let candidate = |d: usize| -> Option<Vec<f64>> {
             let i = d / 2;
-            let step = if d.is_multiple_of(2) { best.mesh } else { -best.mesh };
+            let step = if d.is_multiple_of(2) {
+                best.mesh
+            } else {
+                -best.mesh
+            };
             let v = (best.x[i] + step).clamp(lower[i], upper[i]);
             if v == best.x[i] {
                 return None;
