@@ -270,3 +270,30 @@ fn bad_input_is_refused_with_exit_code_2() {
         "--focus-m",
     );
 }
+
+#[test]
+fn ctrl_c_writes_best_eye_marked_not_converged() {
+    let d = scratch("sigint");
+    let eye = d.join("k.toml");
+    let child = Command::new(env!("CARGO_BIN_EXE_ocular"))
+        .args(["eye", "estimate", "--preset", "keratoconus", "-o"])
+        .arg(&eye)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    let text = ok(&out);
+    assert!(
+        text.contains("NOT converged (stopped: cancelled)"),
+        "{text}"
+    );
+    let r = ocular::eye::file::load(&eye).unwrap().estimate.unwrap();
+    assert!(!r.converged);
+    assert_eq!(r.stop, "cancelled");
+}

@@ -151,6 +151,17 @@ fn same_input_same_eye_whatever_the_thread_count() {
         assert_eq!(a.report.loss.to_bits(), b.report.loss.to_bits());
         assert_eq!(a.report.evaluations, b.report.evaluations);
     }
+    // The opportunistic poll polls in fixed chunks, so it too ignores the thread count.
+    let s = |threads| Settings {
+        method: Method::PatternSearch,
+        opportunistic: true,
+        threads: Some(threads),
+        max_evaluations: 2000,
+        ..Settings::default()
+    };
+    let (a, b) = (run(&target, &s(1)), run(&target, &s(3)));
+    assert_eq!(a.eye, b.eye);
+    assert_eq!(a.report.evaluations, b.report.evaluations);
 }
 
 #[test]
