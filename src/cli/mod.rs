@@ -8,6 +8,8 @@ use crate::Result;
 mod bench;
 mod compare;
 mod devices;
+mod eye;
+mod eye_plot;
 mod kernels;
 mod psf;
 mod raster;
@@ -52,6 +54,8 @@ pub enum Command {
     Raster(raster::RasterArgs),
     /// Precompute an eye's PSF kernel grid (cached), with an optional contact sheet and plot.
     Kernels(Box<kernels::KernelsArgs>),
+    /// Eyes: estimate one from a wavefront or prescription, show, measure, draw, list presets.
+    Eye(Box<eye::EyeArgs>),
 }
 
 impl Cli {
@@ -73,5 +77,14 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Raster(args) => raster::run(&cli, args),
         Command::Psf(args) => psf::run(args),
         Command::Kernels(args) => kernels::run(args),
+        Command::Eye(args) => eye::run(args),
     }
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
+/// reader never sees a partial file and a failed run leaves no file behind.
+pub(crate) fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
+    crate::image_io::write_atomic(path, |w| {
+        std::io::Write::write_all(w, bytes).map_err(|e| format!("cannot write: {e}"))
+    })
 }

@@ -208,16 +208,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
 }
 
 pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
-    if let Some(eye) = Eye::preset(spec) {
-        return Ok(eye);
-    }
-    let text = std::fs::read_to_string(spec).map_err(|e| {
-        Error::input(format!(
-            "--eye {spec}: not a preset ({}) and not a readable file ({e})",
-            crate::eye::presets::PRESET_NAMES.join(", ")
-        ))
-    })?;
-    Eye::from_toml_str(&text).map_err(|e| Error::file(spec, e))
+    Ok(crate::eye::file::resolve(spec)?.eye)
 }
 
 fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {

@@ -3,6 +3,8 @@
 
 pub mod accommodate;
 pub mod draw;
+pub mod estimate;
+pub mod file;
 pub mod fit;
 pub mod lens;
 pub mod measure;

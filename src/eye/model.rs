@@ -273,10 +273,24 @@ impl Eye {
         })
     }
 
-    /// Parses and validates an eye from TOML text.
+    /// Parses and validates an eye from TOML text: either the bare structure, or an eye file
+    /// whose `[eye]` table holds it next to an `[estimate]` record (see `eye::file`).
     pub fn from_toml_str(text: &str) -> Result<Eye, EyeError> {
-        let eye: Eye = toml::from_str(text)
-            .map_err(|e| EyeError::Invalid(format!("eye file: {}", e.message())))?;
+        let bad = |e: toml::de::Error| EyeError::Invalid(format!("eye file: {}", e.message()));
+        let table: toml::Table = toml::from_str(text).map_err(bad)?;
+        let eye: Eye = if let Some(inner) = table.get("eye") {
+            if let Some(k) = table.keys().find(|k| *k != "eye" && *k != "estimate") {
+                return Err(EyeError::Invalid(format!(
+                    "eye file: unknown table {k:?} next to [eye]; allowed: [eye], [estimate]"
+                )));
+            }
+            let toml::Value::Table(t) = inner else {
+                return Err(EyeError::Invalid("eye file: 'eye' must be a table".into()));
+            };
+            t.clone().try_into().map_err(bad)?
+        } else {
+            toml::from_str(text).map_err(bad)?
+        };
         eye.validate()?;
         Ok(eye)
     }

@@ -77,18 +77,31 @@ impl Eye {
         }
     }
 
-    /// A preset by name: `navarro` or `mean`.
+    /// A preset by name: `navarro`, `mean`, or one of the estimated eyes (`healthy`,
+    /// `myopia`, `astigmatism`, `keratoconus`; see `eye::file`).
     pub fn preset(name: &str) -> Option<Eye> {
-        match name {
-            "navarro" => Some(Eye::navarro()),
-            "mean" | "population" => Some(Eye::population_mean()),
-            _ => None,
-        }
+        builtin_preset(name).or_else(|| super::file::preset(name).map(|f| f.eye))
+    }
+}
+
+/// The presets defined in code (no estimate record).
+pub(crate) fn builtin_preset(name: &str) -> Option<Eye> {
+    match name {
+        "navarro" => Some(Eye::navarro()),
+        "mean" | "population" => Some(Eye::population_mean()),
+        _ => None,
     }
 }
 
 /// Names accepted by [`Eye::preset`].
-pub const PRESET_NAMES: [&str; 2] = ["navarro", "mean"];
+pub const PRESET_NAMES: [&str; 6] = [
+    "navarro",
+    "mean",
+    "healthy",
+    "myopia",
+    "astigmatism",
+    "keratoconus",
+];
 
 /// Navarro's (1985) accommodating eye for accommodation `accommodation_d` (his parameter A):
 /// lens radii, conics, thickness, anterior-chamber depth and lens index all follow his
