@@ -49,6 +49,24 @@ pub struct CompareArgs {
     pub texture_format: PsfTextureFormat,
     #[arg(long, default_value_t = 1)]
     pub merge_levels: u32,
+    /// Merge a block only if its smallest blur radius is at least this (px).
+    #[arg(long, default_value_t = 5.0)]
+    pub merge_min_radius: f32,
+    /// Largest colour difference inside a merged block, per pixel of blur radius.
+    #[arg(long, default_value_t = 0.10)]
+    pub merge_color_tolerance: f32,
+    /// Object-distance samples over the seed paper's 0.125–10.125 D range (its 41 by default).
+    #[arg(long, default_value_t = 41)]
+    pub object_samples: usize,
+    /// Largest kernel radius in pixels (larger blur is clamped).
+    #[arg(long, default_value_t = 64)]
+    pub rmax_cap: u32,
+    /// Highest β expansion degree of the PSFs.
+    #[arg(long, default_value_t = 160)]
+    pub beta_degree: u32,
+    /// PSF sample size on the retina in µm (the seed paper's 4).
+    #[arg(long, default_value_t = 4.0)]
+    pub sample_um: f64,
     /// Write the results as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -130,6 +148,10 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         height_px: height,
     };
     let mut options = KernelOptions::default();
+    options.reference_axes.objects = crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
+    options.settings.max_radius_cap = args.rmax_cap;
+    options.settings.max_beta_degree = args.beta_degree;
+    options.settings.sample_um = args.sample_um;
     if args.no_cache {
         options.cache_dir = None;
     } else if let Some(dir) = &args.cache {
