@@ -9,9 +9,12 @@ pub mod cli;
 pub mod error;
 pub mod eye;
 pub mod gpu;
+pub mod image_io;
+pub mod metrics;
 pub mod optics;
 pub mod psf;
 pub mod render;
+pub mod scene;
 
 /// SPIR-V of every shader under `glsl/`, compiled by build.rs.
 pub mod shaders {

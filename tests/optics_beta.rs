@@ -70,6 +70,11 @@ fn parseval_and_adaptive_degree() {
     let be = beta_from_alpha(&a, 550.0, 5.0, None, 1e-12, 6);
     assert_eq!(be.degree, 6);
     assert!(be.truncation_error > 1e-6);
+    for cap in [1, 2, 3] {
+        let be = beta_from_alpha(&a, 550.0, 5.0, None, 1e-12, cap);
+        assert_eq!(be.degree, cap);
+        assert_eq!(be.beta.len(), num_terms(cap));
+    }
 }
 
 #[test]

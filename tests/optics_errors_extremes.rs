@@ -130,6 +130,28 @@ fn extreme_valid_inputs_stay_finite() {
     let psf = compute_psf(&r).unwrap();
     assert!(psf.intensity.iter().all(|v| v.is_finite()));
     assert!(psf.beta_truncation_error > 1e-4 && psf.beta_degree == 60);
+    // a grid reaching beyond r = 20000 λ/NA is refused, not attempted
+    let mut r = PsfRequest::new(vec![], 5.0, 550.0, 900.0, 8000);
+    r.size = 8000;
+    assert!(compute_psf(&r)
+        .unwrap_err()
+        .to_string()
+        .contains("grid extent"));
+    assert!(ocular::optics::enz::VTable::new(20, 10.0, 20000.0, 1e-4).is_err());
+    // the smallest allowed cap still works
+    let mut r = PsfRequest::new(vec![(3, 1, 0.1)], 5.0, 550.0, 0.5, 8);
+    r.max_degree = 1;
+    assert!(compute_psf(&r)
+        .unwrap()
+        .intensity
+        .iter()
+        .all(|v| v.is_finite()));
+    let mut r = PsfRequest::new(vec![(3, 1, 0.1)], 5.0, 550.0, 0.5, 8);
+    r.radial_taps = Some(7);
+    assert!(compute_psf(&r)
+        .unwrap_err()
+        .to_string()
+        .contains("radial_taps"));
     // Stiles–Crawford apodisation lowers the encircled light but keeps the PSF finite
     let mut r = PsfRequest::new(vec![], 7.0, 550.0, 0.25, 32);
     r.stiles_crawford = Some(Default::default());

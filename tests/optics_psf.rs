@@ -505,3 +505,41 @@ fn centred_grids_match_pointwise_field() {
         );
     }
 }
+
+#[test]
+fn through_focus_reuses_one_pupil_expansion() {
+    use ocular::optics::psf::{expand_pupil, psf_from_pupil};
+    let set = preset("myopia").unwrap();
+    let mut req = PsfRequest::new(
+        vec![(2, 0, 5.4127), (4, 0, 0.04), (3, -1, 0.04)],
+        set.pupil_diameter_mm,
+        set.wavelength_nm,
+        2.0,
+        32,
+    );
+    let pupil = expand_pupil(&req).unwrap();
+    assert!(
+        (pupil.base_f - 200.5).abs() < 0.1,
+        "c(2,0) → f: {}",
+        pupil.base_f
+    );
+    for extra in [-200.5, -150.0, 0.0, 37.0] {
+        req.defocus_f = extra;
+        let a = psf_from_pupil(&pupil, &req).unwrap();
+        let b = compute_psf(&req).unwrap();
+        assert_eq!(a.intensity, b.intensity);
+        assert_eq!(a.defocus_f, pupil.base_f + extra);
+    }
+    // refocused by the exact opposite f only the 0.057 µm RMS of higher orders is left:
+    // Maréchal's exp(−(2π·RMS/λ)²) ≈ 0.64 (a slight underestimate at this level)
+    req.defocus_f = -pupil.base_f;
+    req.pitch_lambda_over_na = 0.25;
+    let sharp = psf_from_pupil(&pupil, &req).unwrap();
+    let rms = (2.0f64 * 0.04 * 0.04).sqrt();
+    let marechal = (-(2.0 * PI * rms / (set.wavelength_nm * 1e-3)).powi(2)).exp();
+    assert!(
+        sharp.strehl > marechal && sharp.strehl < marechal + 0.1,
+        "Strehl {} vs Maréchal {marechal}",
+        sharp.strehl
+    );
+}

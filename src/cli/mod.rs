@@ -7,6 +7,8 @@ use crate::Result;
 
 mod devices;
 pub mod kernels;
+mod psf;
+mod raster;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -34,6 +36,10 @@ pub enum Command {
     Devices(devices::DevicesArgs),
     /// Precompute an eye's PSF kernel grid (cached), with an optional contact sheet and plot.
     Kernels(Box<kernels::KernelsArgs>),
+    /// Compute one point-spread function from Zernike coefficients (EXR + JSON sidecar).
+    Psf(psf::PsfArgs),
+    /// Rasterise a scene to linear HDR colour and metric depth (EXR), plus an optional PNG.
+    Raster(raster::RasterArgs),
 }
 
 impl Cli {
@@ -49,5 +55,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match &cli.command {
         Command::Devices(args) => devices::run(&cli, args),
         Command::Kernels(args) => kernels::run(args),
+        Command::Raster(args) => raster::run(&cli, args),
+        Command::Psf(args) => psf::run(args),
     }
 }

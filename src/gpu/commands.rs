@@ -7,7 +7,7 @@ use super::buffer::Buffer;
 use super::context::Context;
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::Image;
-use super::pipeline::{Binding, BindingKind, ComputePipeline};
+use super::pipeline::{Binding, BindingKind, ComputePipeline, PipelineParts};
 
 /// Timestamp pairs per submission; more passes than this in one submission are not timed.
 const MAX_TIMED_PASSES: u32 = 64;
@@ -49,7 +49,7 @@ impl Timings {
 
 pub struct Recorder<'a> {
     ctx: &'a Context,
-    cmd: vk::CommandBuffer,
+    pub(super) cmd: vk::CommandBuffer,
     descriptor_pools: Vec<vk::DescriptorPool>,
     sets_left_in_pool: u32,
     query_pool: Option<vk::QueryPool>,
@@ -58,6 +58,8 @@ pub struct Recorder<'a> {
     passes: Vec<(String, u32)>,
     /// Buffers that must live until the submission has completed (staging data).
     keep_alive: Vec<Buffer>,
+    /// Name of the pipeline whose render pass is open, if one is.
+    pub(super) render_pass_open: Option<String>,
 }
 
 impl Context {
@@ -105,6 +107,7 @@ impl Context {
             open_pass: None,
             passes: Vec::new(),
             keep_alive: Vec::new(),
+            render_pass_open: None,
         };
         let result = recorder.record_and_run(record);
         let timings = result.and_then(|()| recorder.read_timings());
@@ -122,7 +125,7 @@ impl Context {
 }
 
 impl<'a> Recorder<'a> {
-    fn device(&self) -> &ash::Device {
+    pub(super) fn device(&self) -> &ash::Device {
         &self.ctx.shared.device
     }
 
@@ -140,6 +143,12 @@ impl<'a> Recorder<'a> {
             unsafe { device.cmd_reset_query_pool(self.cmd, pool, 0, 2 * MAX_TIMED_PASSES) };
         }
         record(self)?;
+        if let Some(name) = self.render_pass_open.take() {
+            return Err(GpuError::Usage {
+                pass: name,
+                message: "render pass begun but never ended".into(),
+            });
+        }
         if self.open_pass.is_some() {
             self.end_pass();
         }
@@ -394,7 +403,8 @@ impl<'a> Recorder<'a> {
         self.barrier();
     }
 
-    pub(crate) fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+    /// Copies the whole image into `dst`, tightly packed (row-major x, then y, then z).
+    pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(src.subresource_layers())
             .image_extent(src.vk_extent())];
@@ -427,7 +437,10 @@ impl<'a> Recorder<'a> {
         self.barrier();
     }
 
-    fn allocate_set(&mut self, pipeline: &ComputePipeline) -> GpuResult<vk::DescriptorSet> {
+    fn allocate_set(
+        &mut self,
+        set_layout: vk::DescriptorSetLayout,
+    ) -> GpuResult<vk::DescriptorSet> {
         if self.sets_left_in_pool == 0 {
             let sizes = [
                 vk::DescriptorPoolSize {
@@ -456,7 +469,7 @@ impl<'a> Recorder<'a> {
             self.descriptor_pools.push(pool);
             self.sets_left_in_pool = SETS_PER_POOL;
         }
-        let layouts = [pipeline.set_layout];
+        let layouts = [set_layout];
         let info = vk::DescriptorSetAllocateInfo::default()
             .descriptor_pool(*self.descriptor_pools.last().expect("pool just ensured"))
             .set_layouts(&layouts);
@@ -477,11 +490,21 @@ impl<'a> Recorder<'a> {
         push_constants: &P,
         groups: [u32; 3],
     ) -> GpuResult<()> {
-        self.bind(pipeline, bindings, bytemuck::bytes_of(push_constants))?;
+        if let Some(open) = &self.render_pass_open {
+            return Err(GpuError::Usage {
+                pass: pipeline.name.clone(),
+                message: format!("dispatch inside the render pass of \"{open}\""),
+            });
+        }
+        self.bind(
+            &pipeline.parts(),
+            bindings,
+            bytemuck::bytes_of(push_constants),
+        )?;
         let max = self.ctx.limits().max_compute_work_group_count;
         if groups.iter().zip(max.iter()).any(|(g, m)| g > m) {
             return Err(GpuError::Usage {
-                pass: pipeline.name.clone(),
+                pass: pipeline.name.to_string(),
                 message: format!(
                     "dispatch of {groups:?} workgroups exceeds the device limit {max:?}"
                 ),
@@ -508,7 +531,11 @@ impl<'a> Recorder<'a> {
         args: &Buffer,
         offset: u64,
     ) -> GpuResult<()> {
-        self.bind(pipeline, bindings, bytemuck::bytes_of(push_constants))?;
+        self.bind(
+            &pipeline.parts(),
+            bindings,
+            bytemuck::bytes_of(push_constants),
+        )?;
         // SAFETY: recording; the args buffer has INDIRECT usage and holds 12 bytes at offset.
         unsafe {
             self.device()
@@ -518,14 +545,14 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
-    fn bind(
+    pub(crate) fn bind(
         &mut self,
-        pipeline: &ComputePipeline,
+        pipeline: &PipelineParts<'_>,
         bindings: &[Binding<'_>],
         push: &[u8],
     ) -> GpuResult<()> {
         let usage = |message: String| GpuError::Usage {
-            pass: pipeline.name.clone(),
+            pass: pipeline.name.to_string(),
             message,
         };
         if bindings.len() != pipeline.kinds.len() {
@@ -542,13 +569,17 @@ impl<'a> Recorder<'a> {
                 pipeline.push_constant_bytes
             )));
         }
-        for (i, (binding, kind)) in bindings.iter().zip(&pipeline.kinds).enumerate() {
+        for (i, (binding, kind)) in bindings.iter().zip(pipeline.kinds).enumerate() {
             if !binding.matches(*kind) {
                 return Err(usage(format!("binding {i} must be a {kind:?}")));
             }
         }
         let max_range = u64::from(self.ctx.limits().max_storage_buffer_range);
-        let set = self.allocate_set(pipeline)?;
+        let set = if pipeline.kinds.is_empty() {
+            None
+        } else {
+            Some(self.allocate_set(pipeline.set_layout)?)
+        };
         let mut buffer_infos = Vec::with_capacity(bindings.len());
         let mut image_infos = Vec::with_capacity(bindings.len());
         for (i, binding) in bindings.iter().enumerate() {
@@ -607,7 +638,7 @@ impl<'a> Recorder<'a> {
         for (i, info) in &buffer_infos {
             writes.push(
                 vk::WriteDescriptorSet::default()
-                    .dst_set(set)
+                    .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
                     .descriptor_type(pipeline.kinds[*i].descriptor_type())
                     .buffer_info(std::slice::from_ref(info)),
@@ -616,7 +647,7 @@ impl<'a> Recorder<'a> {
         for (i, info) in &image_infos {
             writes.push(
                 vk::WriteDescriptorSet::default()
-                    .dst_set(set)
+                    .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
                     .descriptor_type(pipeline.kinds[*i].descriptor_type())
                     .image_info(std::slice::from_ref(info)),
@@ -626,24 +657,20 @@ impl<'a> Recorder<'a> {
         // SAFETY: the set is freshly allocated for this layout; infos outlive the call; the
         // command buffer is recording.
         unsafe {
-            device.update_descriptor_sets(&writes, &[]);
-            device.cmd_bind_pipeline(self.cmd, vk::PipelineBindPoint::COMPUTE, pipeline.pipeline);
-            device.cmd_bind_descriptor_sets(
-                self.cmd,
-                vk::PipelineBindPoint::COMPUTE,
-                pipeline.layout,
-                0,
-                &[set],
-                &[],
-            );
-            if !push.is_empty() {
-                device.cmd_push_constants(
+            device.cmd_bind_pipeline(self.cmd, pipeline.bind_point, pipeline.pipeline);
+            if let Some(set) = set {
+                device.update_descriptor_sets(&writes, &[]);
+                device.cmd_bind_descriptor_sets(
                     self.cmd,
+                    pipeline.bind_point,
                     pipeline.layout,
-                    vk::ShaderStageFlags::COMPUTE,
                     0,
-                    push,
+                    &[set],
+                    &[],
                 );
+            }
+            if !push.is_empty() {
+                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.stages, 0, push);
             }
         }
         Ok(())

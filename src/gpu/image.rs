@@ -139,6 +139,7 @@ pub struct Image {
     format: TexelFormat,
     name: String,
     is_3d: bool,
+    samples: u32,
 }
 
 impl Image {
@@ -199,6 +200,14 @@ impl Image {
         let samples = vk::SampleCountFlags::from_raw(usage.samples.max(1));
         let props = ctx.image_format_properties(format.vk(), image_type, usage.flags());
         let max = props.map(|p| p.max_extent).unwrap_or_default();
+        let sample_counts = props.map(|p| p.sample_counts).unwrap_or_default();
+        if !sample_counts.contains(samples) {
+            return Err(GpuError::Unsupported(format!(
+                "{} images with {} samples per texel (image \"{name}\"); use fewer MSAA samples",
+                format.name(),
+                usage.samples.max(1)
+            )));
+        }
         if extent[0] > max.width || extent[1] > max.height || extent[2] > max.depth {
             return Err(GpuError::Unsupported(format!(
                 "{kind} {} images of {}×{}×{} texels (image \"{name}\"; this device allows up to {}×{}×{}); \
@@ -275,6 +284,7 @@ impl Image {
             format,
             name: name.to_string(),
             is_3d,
+            samples: usage.samples.max(1),
         };
         let allocation = image.allocation.as_ref().expect("just set");
         // SAFETY: memory and image belong to this device; the allocator honours alignment.
@@ -351,6 +361,11 @@ impl Image {
         self.is_3d
     }
 
+    /// Samples per texel: 1 except for multisampled render targets.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
     pub fn size_bytes(&self) -> u64 {
         self.extent().iter().map(|&e| e as u64).product::<u64>() * self.format.bytes_per_texel()
     }
@@ -374,9 +389,10 @@ impl Image {
             bytes.len() as u64,
             Residency::Upload,
         )?;
+        // Buffers are at least 16 bytes: a tiny image fills only the start of its staging.
         staging
             .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")
+            .expect("upload buffers are host-visible")[..bytes.len()]
             .copy_from_slice(bytes);
         ctx.submit(|rec| {
             rec.copy_buffer_to_image(&staging, self);
@@ -400,7 +416,9 @@ impl Image {
         let bytes = readback
             .mapped_bytes()
             .expect("read-back buffers are host-visible");
-        Ok(bytemuck::pod_collect_to_vec(bytes))
+        Ok(bytemuck::pod_collect_to_vec(
+            &bytes[..self.size_bytes() as usize],
+        ))
     }
 }
 
@@ -437,6 +455,8 @@ pub enum Edge {
     /// Texels outside read as transparent black: a PSF kernel fades to zero at its border.
     ZeroBorder,
     ClampToEdge,
+    /// Coordinates wrap around: tiled textures on meshes.
+    Repeat,
 }
 
 pub struct Sampler {
@@ -450,6 +470,7 @@ impl Sampler {
         let mode = match edge {
             Edge::ZeroBorder => vk::SamplerAddressMode::CLAMP_TO_BORDER,
             Edge::ClampToEdge => vk::SamplerAddressMode::CLAMP_TO_EDGE,
+            Edge::Repeat => vk::SamplerAddressMode::REPEAT,
         };
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(vk::Filter::LINEAR)

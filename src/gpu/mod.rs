@@ -6,8 +6,10 @@ mod buffer;
 mod commands;
 mod context;
 mod error;
+mod graphics;
 mod image;
 mod pipeline;
+mod render_pass;
 pub mod texture_probe;
 
 pub use buffer::{Buffer, Residency};
@@ -17,6 +19,10 @@ pub use context::{
     ValidationLog,
 };
 pub use error::{GpuError, GpuResult};
+pub use graphics::{
+    CullMode, DepthCompare, Framebuffer, GraphicsPipeline, GraphicsPipelineBuilder,
+    VertexAttribute, VertexFormat,
+};
 pub use image::{Edge, Image, ImageUsage, Sampler, TexelFormat};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, ComputePipelineBuilder};
 

@@ -57,6 +57,18 @@ impl Binding<'_> {
     }
 }
 
+/// What the recorder needs to bind any pipeline, compute or graphics, with its resources.
+pub(crate) struct PipelineParts<'p> {
+    pub(crate) name: &'p str,
+    pub(crate) kinds: &'p [BindingKind],
+    pub(crate) push_constant_bytes: u32,
+    pub(crate) set_layout: vk::DescriptorSetLayout,
+    pub(crate) layout: vk::PipelineLayout,
+    pub(crate) pipeline: vk::Pipeline,
+    pub(crate) bind_point: vk::PipelineBindPoint,
+    pub(crate) stages: vk::ShaderStageFlags,
+}
+
 pub struct ComputePipeline {
     shared: Arc<DeviceShared>,
     pub(crate) name: String,
@@ -89,6 +101,19 @@ impl ComputePipeline {
 
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    pub(crate) fn parts(&self) -> PipelineParts<'_> {
+        PipelineParts {
+            name: &self.name,
+            kinds: &self.kinds,
+            push_constant_bytes: self.push_constant_bytes,
+            set_layout: self.set_layout,
+            layout: self.layout,
+            pipeline: self.pipeline,
+            bind_point: vk::PipelineBindPoint::COMPUTE,
+            stages: vk::ShaderStageFlags::COMPUTE,
+        }
     }
 }
 

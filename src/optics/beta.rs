@@ -178,9 +178,8 @@ pub fn beta_from_alpha(
     };
     // Start at the degree of the wavefront itself (the pupil function needs at least that),
     // then double: the sampling cost grows with the degree, so small aberrations stay cheap.
-    let mut deg = order_for_len(alpha_um.len())
-        .clamp(4, max_degree.max(1))
-        .min(max_degree);
+    let max_degree = max_degree.max(1);
+    let mut deg = order_for_len(alpha_um.len()).max(4).min(max_degree);
     loop {
         let (beta, energy) = project(alpha_um, lam_um, &amp, deg);
         let cum = cumulative_energy(&beta, deg);

@@ -447,6 +447,14 @@ impl VTable {
             });
         }
         let nt = super::zernike::num_terms(max_order);
+        let cells = (r_max / step + 7.0) * nt as f64;
+        check_range(
+            "table size (nodes x terms)",
+            cells,
+            0.0,
+            5e7,
+            "at most 5e7 values: raise step or lower r_max/max_order",
+        )?;
         let w = defocus_weights(f);
         // D for (n, μ ≥ 0); negative m follow by parity.
         let mut coeffs: Vec<(usize, u32, Vec<Complex64>)> = Vec::new();

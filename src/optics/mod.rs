@@ -12,6 +12,7 @@ pub mod beta;
 pub mod enz;
 pub mod field;
 pub mod psf;
+pub mod pupil;
 pub mod quadrature;
 pub mod zernike;
 

@@ -315,6 +315,16 @@ fn synthesize(
     let p = req.pitch_lambda_over_na;
     let half = (n / 2) as i64;
     let (sx, sy) = shift;
+    let centred = sx == 0.0 && sy == 0.0;
+    // Per pixel and azimuthal combination, in tap-equivalents: a centred grid shares the
+    // interpolation and half the angular work among four mirror images.
+    let pixel_taps = |t: usize| {
+        if centred {
+            t as f64 / 4.0 + 2.2
+        } else {
+            t as f64 + 9.0
+        }
+    };
     let c_count = rf.combos();
     let mut intensity = vec![0.0; n * n];
     // Interpolation order by a cost model: table nodes cost one radial evaluation each,
@@ -336,8 +346,7 @@ fn synthesize(
         .map(|&t| {
             let rule = LagrangeRule::new(t);
             let step = rule.step_for(req.radial_tolerance);
-            let cost =
-                rmax0 / step * work + PIXEL_WEIGHT * pixels * c_count as f64 * (t as f64 + 9.0);
+            let cost = rmax0 / step * work + PIXEL_WEIGHT * pixels * c_count as f64 * pixel_taps(t);
             (cost, rule, step)
         })
         .min_by(|a, b| a.0.total_cmp(&b.0))
@@ -363,10 +372,9 @@ fn synthesize(
     }
     let row_x = |col: usize| (col as f64 - half as f64) * p + sx;
     let row_y = |row: usize| (half as f64 - row as f64) * p + sy;
-    let exact_cost = keys.len() as f64 * work + PIXEL_WEIGHT * pixels * c_count as f64 * 5.0;
-    let table_cost = table_nodes as f64 * work
-        + PIXEL_WEIGHT * pixels * c_count as f64 * (rule.taps as f64 + 9.0);
-    let centred = sx == 0.0 && sy == 0.0;
+    let exact_cost = keys.len() as f64 * work + PIXEL_WEIGHT * pixels * c_count as f64 * 2.2;
+    let table_cost =
+        table_nodes as f64 * work + PIXEL_WEIGHT * pixels * c_count as f64 * pixel_taps(rule.taps);
     if exact && exact_cost <= table_cost {
         let mut index = vec![u32::MAX; kmax];
         for (i, &k) in keys.iter().enumerate() {
@@ -416,13 +424,30 @@ fn synthesize(
                 radial,
             );
         } else {
-            let row_fn = |row: usize, out: &mut [f64]| {
+            // Visit pixels in order of radius: neighbours then read the same table rows,
+            // which stay in cache (the table itself is usually far larger than the cache).
+            let mut order: Vec<(f64, u32)> = (0..n * n)
+                .map(|i| (row_x(i % n).hypot(row_y(i / n)), i as u32))
+                .collect();
+            order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            let eval = |chunk: &[(f64, u32)]| -> Vec<f64> {
                 let mut g = vec![Complex64::default(); c_count];
-                for (col, o) in out.iter_mut().enumerate() {
-                    *o = table.at(row_x(col), row_y(row), &mut g).norm_sqr();
-                }
+                chunk
+                    .iter()
+                    .map(|&(_, i)| {
+                        let i = i as usize;
+                        table.at(row_x(i % n), row_y(i / n), &mut g).norm_sqr()
+                    })
+                    .collect()
             };
-            fill_rows(&mut intensity, n, req.parallel, row_fn);
+            let values: Vec<f64> = if req.parallel {
+                order.par_chunks(4096).flat_map_iter(eval).collect()
+            } else {
+                eval(&order)
+            };
+            for (&(_, i), v) in order.iter().zip(values) {
+                intensity[i as usize] = v;
+            }
         }
         (intensity, step, table.rule.taps, table.nodes(), t2)
     }
@@ -487,34 +512,34 @@ fn symmetric_fill(
 }
 
 /// Cost of one pixel·combination·tap in units of radial work (see `synthesize`).
-const PIXEL_WEIGHT: f64 = 8.75;
+const PIXEL_WEIGHT: f64 = 4.5;
 
-fn fill_rows(out: &mut [f64], n: usize, parallel: bool, f: impl Fn(usize, &mut [f64]) + Sync) {
-    if parallel {
-        out.par_chunks_mut(n).enumerate().for_each(|(r, o)| f(r, o));
-    } else {
-        out.chunks_mut(n).enumerate().for_each(|(r, o)| f(r, o));
-    }
+/// The pupil part of a request, expanded once and reusable for any defocus and grid with the
+/// same wavefront, pupil, wavelength and apodisation (e.g. a through-focus series).
+#[derive(Debug, Clone)]
+pub struct Pupil {
+    pub beta: BetaExpansion,
+    /// f contributed by the wavefront's own c(2,0).
+    pub base_f: f64,
+    pub tilt_shift: (f64, f64),
+    pub pupil_diameter_mm: f64,
+    pub wavelength_nm: f64,
+    pub stiles_crawford: Option<StilesCrawford>,
+    pub seconds: f64,
 }
 
-/// Compute one PSF. Errors name the offending field; nothing here panics on bad input.
-pub fn compute_psf(req: &PsfRequest) -> Result<Psf, OpticsError> {
+/// Expand the pupil of `req` (wavefront, pupil, wavelength, apodisation, β settings); the grid
+/// fields and `defocus_f` are validated but not used.
+pub fn expand_pupil(req: &PsfRequest) -> Result<Pupil, OpticsError> {
     validate(req)?;
     let split = split_wavefront(
         &req.coefficients_um,
         req.wavelength_nm,
-        req.defocus_f,
+        0.0,
         req.include_tilt,
     );
-    check_range(
-        "total defocus f",
-        split.f,
-        -MAX_ABS_F,
-        MAX_ABS_F,
-        "|f| <= 5000 (requested f plus 4*sqrt(3)*pi*c(2,0)/lambda)",
-    )?;
     let t0 = Instant::now();
-    let be = beta_from_alpha(
+    let beta = beta_from_alpha(
         &split.alpha_um,
         req.wavelength_nm,
         req.pupil_diameter_mm,
@@ -522,27 +547,32 @@ pub fn compute_psf(req: &PsfRequest) -> Result<Psf, OpticsError> {
         req.beta_tolerance,
         req.max_degree,
     );
-    let seconds_beta = t0.elapsed().as_secs_f64();
-    let mut psf = psf_from_expansion(req, &be, split.f, split.tilt_shift)?;
-    psf.seconds_beta = seconds_beta;
-    Ok(psf)
+    Ok(Pupil {
+        beta,
+        base_f: split.f,
+        tilt_shift: split.tilt_shift,
+        pupil_diameter_mm: req.pupil_diameter_mm,
+        wavelength_nm: req.wavelength_nm,
+        stiles_crawford: req.stiles_crawford,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
 }
 
-/// The PSF of an already expanded pupil at total defocus `f` (sign kept), shifted by
-/// `tilt_shift` (λ/NA). Only the grid and numerical fields of `req` are used (its coefficients
-/// are ignored): callers that image one pupil at many defocus values expand β once and call
-/// this per f, since β does not depend on f.
-pub fn psf_from_expansion(
-    req: &PsfRequest,
-    be: &BetaExpansion,
-    f: f64,
-    tilt_shift: (f64, f64),
-) -> Result<Psf, OpticsError> {
-    let grid_only = PsfRequest {
-        coefficients_um: Vec::new(),
-        ..req.clone()
-    };
-    validate(&grid_only)?;
+/// PSF of an expanded pupil at total defocus `pupil.base_f + req.defocus_f` on the grid of
+/// `req` (size, pitch, radial settings, parallelism); the wavefront fields of `req` are ignored.
+pub fn psf_from_pupil(pupil: &Pupil, req: &PsfRequest) -> Result<Psf, OpticsError> {
+    validate(req)?;
+    let f = pupil.base_f + req.defocus_f;
+    let extent =
+        (req.size as f64 / 2.0 + 1.0) * req.pitch_lambda_over_na * std::f64::consts::SQRT_2
+            + pupil.tilt_shift.0.hypot(pupil.tilt_shift.1);
+    check_range(
+        "grid extent (size/2 * pitch * sqrt(2) + tilt shift)",
+        extent,
+        0.0,
+        super::enz::MAX_R,
+        "at most 20000 lambda/NA",
+    )?;
     check_range(
         "total defocus f",
         f,
@@ -550,11 +580,13 @@ pub fn psf_from_expansion(
         MAX_ABS_F,
         "|f| <= 5000 (requested f plus 4*sqrt(3)*pi*c(2,0)/lambda)",
     )?;
+    let be = &pupil.beta;
     let t1 = Instant::now();
     let n = req.size;
     let rf = RadialField::new(&be.beta, be.degree, f);
     let t1b = Instant::now();
-    let (intensity, radial_step, radial_taps, radial_nodes, t2) = synthesize(&rf, req, tilt_shift);
+    let (intensity, radial_step, radial_taps, radial_nodes, t2) =
+        synthesize(&rf, req, pupil.tilt_shift);
     let t3 = Instant::now();
     let peak = intensity.iter().cloned().fold(0.0, f64::max);
     let sum: f64 = intensity.iter().sum();
@@ -566,19 +598,26 @@ pub fn psf_from_expansion(
         pitch_lambda_over_na: req.pitch_lambda_over_na,
         intensity,
         defocus_f: f,
-        tilt_shift,
+        tilt_shift: pupil.tilt_shift,
         beta_degree: be.degree,
         beta_truncation_error: be.truncation_error,
         beta_energy,
-        strehl: peak / ideal_peak(req.stiles_crawford, req.pupil_diameter_mm),
+        strehl: peak / ideal_peak(pupil.stiles_crawford, pupil.pupil_diameter_mm),
         peak_intensity: peak,
         energy_in_grid,
         radial_step,
         radial_taps,
         radial_nodes,
-        seconds_beta: 0.0,
+        seconds_beta: pupil.seconds,
         seconds_coefficients: (t1b - t1).as_secs_f64(),
         seconds_table: (t2 - t1b).as_secs_f64(),
         seconds_synthesis: (t3 - t2).as_secs_f64(),
     })
+}
+
+/// Compute one PSF ([`expand_pupil`] then [`psf_from_pupil`]). Errors name the offending
+/// field; nothing here panics on bad input.
+pub fn compute_psf(req: &PsfRequest) -> Result<Psf, OpticsError> {
+    let pupil = expand_pupil(req)?;
+    psf_from_pupil(&pupil, req)
 }

@@ -271,8 +271,16 @@ pub fn basis_gradients(max_order: u32, x: f64, y: f64, out_dx: &mut [f64], out_d
     );
     let s = 2.0 * (x * x + y * y) - 1.0;
     let kmax = max_order as usize / 2 + 1;
-    let mut p = vec![0.0; kmax];
-    let mut dp = vec![0.0; kmax];
+    // Stack buffers for the usual orders: this runs inside optimisers' inner loops.
+    let (mut ps, mut dps) = ([0.0f64; 64], [0.0f64; 64]);
+    let (mut ph, mut dph);
+    let (p, dp): (&mut [f64], &mut [f64]) = if kmax <= 64 {
+        (&mut ps[..], &mut dps[..])
+    } else {
+        ph = vec![0.0; kmax];
+        dph = vec![0.0; kmax];
+        (&mut ph[..], &mut dph[..])
+    };
     // z^m and z^(m-1) with z = x + iy; d/dx z^m = m z^(m-1), d/dy z^m = i m z^(m-1).
     let (mut re, mut im) = (1.0f64, 0.0f64);
     let (mut re1, mut im1) = (0.0f64, 0.0f64);

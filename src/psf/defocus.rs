@@ -26,8 +26,8 @@
 
 use super::axes::KernelSettings;
 use crate::eye::{accommodate, measure, Eye};
-use crate::optics::beta::{beta_from_alpha, BetaExpansion};
-use crate::optics::psf::defocus_f_from_c20;
+use crate::optics::beta::beta_from_alpha;
+use crate::optics::psf::{defocus_f_from_c20, Pupil};
 use crate::optics::zernike::{order_for_len, wavefront_gradient};
 use crate::{Error, Result};
 use std::f64::consts::PI;
@@ -46,7 +46,8 @@ pub struct ChannelOptics {
     pub entrance_pupil_m: f64,
     /// Measured wavefront without piston, tilt and c(2,0) (OSA, µm).
     pub alpha_um: Vec<f64>,
-    pub beta: BetaExpansion,
+    /// β of the residual wavefront (defocus and tilt excluded; f is added per object).
+    pub pupil: Pupil,
     /// Ray displacement of the residual wavefront, ∇W/λ (λ/NA), at pupil points (x, y).
     slopes: Vec<([f64; 2], [f64; 2])>,
 }
@@ -67,6 +68,7 @@ impl ChannelOptics {
         for j in [0, 1, 2, 4] {
             alpha_um[j] = 0.0;
         }
+        let t0 = std::time::Instant::now();
         let beta = beta_from_alpha(
             &alpha_um,
             wavelength_nm,
@@ -97,7 +99,15 @@ impl ChannelOptics {
             focus_vergence,
             entrance_pupil_m,
             alpha_um,
-            beta,
+            pupil: Pupil {
+                beta,
+                base_f: 0.0,
+                tilt_shift: (0.0, 0.0),
+                pupil_diameter_mm: pupil_mm,
+                wavelength_nm,
+                stiles_crawford: None,
+                seconds: t0.elapsed().as_secs_f64(),
+            },
             slopes,
         }
     }

@@ -247,7 +247,10 @@ fn column_report(c: &ColumnOptics) -> ColumnReport {
             .channels
             .each_ref()
             .map(|ch| -4.0 * 3f64.sqrt() * ch.residual_c20_um / r2),
-        beta_degree: c.channels.each_ref().map(|ch| ch.beta.degree),
-        beta_truncation_error: c.channels.each_ref().map(|ch| ch.beta.truncation_error),
+        beta_degree: c.channels.each_ref().map(|ch| ch.pupil.beta.degree),
+        beta_truncation_error: c
+            .channels
+            .each_ref()
+            .map(|ch| ch.pupil.beta.truncation_error),
     }
 }

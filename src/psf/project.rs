@@ -15,7 +15,7 @@
 
 use super::axes::{KernelSettings, Screen};
 use super::defocus::ChannelOptics;
-use crate::optics::psf::{pitch_from_arcmin, psf_from_expansion, PsfRequest};
+use crate::optics::psf::{pitch_from_arcmin, psf_from_pupil, PsfRequest};
 use crate::Result;
 
 /// Largest PSF grid side; beyond it the pitch grows (the kernels are far coarser anyway).
@@ -271,7 +271,8 @@ pub fn cropped_psf_at_f(
     req.include_tilt = false;
     req.radial_tolerance = settings.radial_tolerance;
     req.beta_tolerance = settings.beta_tolerance;
-    let psf = psf_from_expansion(&req, &ch.beta, f, (0.0, 0.0))?;
+    req.defocus_f = f;
+    let psf = psf_from_pupil(&ch.pupil, &req)?;
     let pixels_per_sample = pitch * ch.radians_per_lambda_na() * screen.px_per_radian();
     Ok(crop(
         &psf.intensity,

@@ -1,4 +1,9 @@
-//! Rendering: joins the eye's kernels (`psf`) with the GPU layer (`gpu`).
+//! Rendering: joins scenes, the eye's kernels (`psf`) and the GPU layer (`gpu`). Each GPU pass
+//! is one Rust file plus GLSL files of the same stem under glsl/render/.
 
+pub mod raster;
 pub mod reference;
+pub mod slices;
 pub mod splat;
+
+pub use raster::{Frame, Rasterizer, MSAA_SAMPLES};

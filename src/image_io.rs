@@ -1,0 +1,410 @@
+//! Reading and writing images: OpenEXR for linear HDR colour and metric depth, PNG for
+//! previews. Every write is atomic (a temporary file in the same folder, fsync, rename), so a
+//! failed or interrupted write never leaves a partial file under the final name. Every failure
+//! is an `Error::File` naming the file.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use crate::{Error, Result};
+
+/// Linear RGBA, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageRgba {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// One channel (depth in metres, luminance, …), row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageGray {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<f32>,
+}
+
+impl ImageRgba {
+    pub fn new(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> ImageRgba {
+        assert_eq!(pixels.len(), width as usize * height as usize);
+        ImageRgba {
+            width,
+            height,
+            pixels,
+        }
+    }
+}
+
+impl ImageGray {
+    pub fn new(width: u32, height: u32, pixels: Vec<f32>) -> ImageGray {
+        assert_eq!(pixels.len(), width as usize * height as usize);
+        ImageGray {
+            width,
+            height,
+            pixels,
+        }
+    }
+}
+
+/// Relative luminance of linear Rec.709/sRGB primaries; in ocular's calibrated frames it is
+/// in cd/m².
+pub fn luminance(rgb: [f32; 3]) -> f32 {
+    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TonemapMode {
+    /// Scale by the exposure, then clip at 1.
+    #[default]
+    Clamp,
+    /// Scale by the exposure, then compress luminance with L / (1 + L) (hue kept).
+    Reinhard,
+}
+
+/// How linear HDR values become an 8-bit preview.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tonemap {
+    /// Linear values are multiplied by 2^exposure_ev before the curve.
+    pub exposure_ev: f32,
+    pub mode: TonemapMode,
+}
+
+impl Default for Tonemap {
+    fn default() -> Self {
+        Tonemap {
+            exposure_ev: 0.0,
+            mode: TonemapMode::Clamp,
+        }
+    }
+}
+
+impl Tonemap {
+    /// Exposure that maps the image's log-average luminance to middle grey (0.18): a sensible
+    /// default for luminance-calibrated frames whose values are in cd/m².
+    pub fn auto_exposure_ev(image: &ImageRgba) -> f32 {
+        let mut sum = 0.0f64;
+        let mut count = 0usize;
+        for p in &image.pixels {
+            let y = luminance([p[0], p[1], p[2]]);
+            if y.is_finite() && y > 0.0 {
+                sum += f64::from(y.max(1e-4)).ln();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return 0.0;
+        }
+        let log_average = (sum / count as f64).exp();
+        (0.18 / log_average).log2() as f32
+    }
+
+    fn apply(&self, rgb: [f32; 3]) -> [f32; 3] {
+        let scale = self.exposure_ev.exp2();
+        let rgb = rgb.map(|c| {
+            if c.is_finite() {
+                c.max(0.0) * scale
+            } else {
+                0.0
+            }
+        });
+        match self.mode {
+            TonemapMode::Clamp => rgb,
+            TonemapMode::Reinhard => {
+                let y = luminance(rgb);
+                let k = 1.0 / (1.0 + y);
+                rgb.map(|c| c * k)
+            }
+        }
+    }
+}
+
+/// The sRGB transfer function of a linear value in [0, 1].
+fn srgb_encode(linear: f32) -> f32 {
+    let c = linear.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Decodes an 8-bit sRGB value to linear.
+pub fn srgb_decode(encoded: u8) -> f32 {
+    let c = f32::from(encoded) / 255.0;
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn file_error(path: &Path, message: impl std::fmt::Display) -> Error {
+    Error::file(path, message)
+}
+
+/// Writes a file through `write` into `NAME.tmp-PID` next to `path`, syncs it and renames it
+/// into place; on any failure the temporary file is removed and `path` is untouched.
+pub fn write_atomic<F>(path: &Path, write: F) -> Result<()>
+where
+    F: FnOnce(&mut BufWriter<std::fs::File>) -> std::result::Result<(), String>,
+{
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| file_error(path, "not a file name"))?;
+    let mut tmp_name = file_name.to_os_string();
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp: PathBuf = path.with_file_name(tmp_name);
+    let result = (|| -> std::result::Result<(), String> {
+        let file = std::fs::File::create(&tmp).map_err(|e| format!("cannot create: {e}"))?;
+        let mut writer = BufWriter::new(file);
+        write(&mut writer)?;
+        writer.flush().map_err(|e| format!("cannot write: {e}"))?;
+        let file = writer
+            .into_inner()
+            .map_err(|e| format!("cannot write: {}", e.error()))?;
+        file.sync_all().map_err(|e| format!("cannot sync: {e}"))?;
+        drop(file);
+        std::fs::rename(&tmp, path).map_err(|e| format!("cannot rename into place: {e}"))
+    })();
+    if let Err(message) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(file_error(path, message));
+    }
+    // Make the rename itself durable where the platform allows syncing a folder.
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Ok(d) = std::fs::File::open(dir) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(())
+}
+
+/// Writes `text` to `path` atomically (see [`write_atomic`]).
+pub fn write_text_atomic(path: impl AsRef<Path>, text: &str) -> Result<()> {
+    write_atomic(path.as_ref(), |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| format!("cannot write: {e}"))
+    })
+}
+
+fn check_size(path: &Path, width: u32, height: u32, len: usize) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(file_error(
+            path,
+            format!("cannot write an empty {width}×{height} image"),
+        ));
+    }
+    if len != width as usize * height as usize {
+        return Err(file_error(
+            path,
+            format!("{len} pixels do not make a {width}×{height} image"),
+        ));
+    }
+    Ok(())
+}
+
+/// Reads the first RGB(A) layer of an EXR as f32 (missing alpha reads as 1).
+pub fn read_exr_rgba(path: impl AsRef<Path>) -> Result<ImageRgba> {
+    use exr::prelude::*;
+    let path = path.as_ref();
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgba_channels(
+            |resolution, _| ImageRgba {
+                width: resolution.width() as u32,
+                height: resolution.height() as u32,
+                pixels: vec![[0.0; 4]; resolution.width() * resolution.height()],
+            },
+            |image: &mut ImageRgba, position, (r, g, b, a): (f32, f32, f32, f32)| {
+                let i = position.y() * image.width as usize + position.x();
+                image.pixels[i] = [r, g, b, a];
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| exr_read_error(path, e, "R, G and B channels (A optional)"))?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+fn exr_read_error(path: &Path, error: exr::error::Error, wanted: &str) -> Error {
+    match error {
+        exr::error::Error::Io(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            file_error(path, "no such file")
+        }
+        exr::error::Error::Io(e) => file_error(path, format!("cannot read: {e}")),
+        exr::error::Error::NotSupported(m) => {
+            file_error(path, format!("unsupported EXR feature: {m}"))
+        }
+        exr::error::Error::Invalid(m) if m.contains("layer") || m.contains("channel") => {
+            file_error(path, format!("not an EXR with {wanted}: {m}"))
+        }
+        e => file_error(path, format!("not a valid EXR file ({e})")),
+    }
+}
+
+/// Channel names accepted for depth, in order of preference.
+const DEPTH_CHANNELS: [&str; 4] = ["Z", "depth", "Y", "R"];
+
+/// Reads one channel of an EXR: the first of Z, depth, Y, R present (case-insensitive, also
+/// as the last component of a layered name such as `view.Z`), or the only channel. When
+/// several candidates are present it says on stderr which one it used.
+pub fn read_exr_depth(path: impl AsRef<Path>) -> Result<ImageGray> {
+    let path = path.as_ref();
+    let (image, used, candidates) = read_exr_depth_channel(path)?;
+    if candidates.len() > 1 {
+        eprintln!(
+            "note: {}: using channel {used} as depth (candidates present: {})",
+            path.display(),
+            candidates.join(", ")
+        );
+    }
+    Ok(image)
+}
+
+/// As `read_exr_depth`, also returning the channel used and every candidate channel present.
+pub fn read_exr_depth_channel(path: impl AsRef<Path>) -> Result<(ImageGray, String, Vec<String>)> {
+    use exr::prelude::*;
+    let path = path.as_ref();
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| exr_read_error(path, e, "a depth channel"))?;
+    let layer = &image.layer_data;
+    let names: Vec<String> = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    let base = |name: &str| name.rsplit('.').next().unwrap_or(name).to_lowercase();
+    let chosen = if names.len() == 1 {
+        0
+    } else {
+        DEPTH_CHANNELS
+            .iter()
+            .find_map(|want| names.iter().position(|n| base(n) == want.to_lowercase()))
+            .ok_or_else(|| {
+                file_error(
+                    path,
+                    format!(
+                        "no depth channel: found {}; expected one named Z, depth, Y or R, or a \
+                         single-channel file",
+                        names.join(", ")
+                    ),
+                )
+            })?
+    };
+    let candidates: Vec<String> = names
+        .iter()
+        .filter(|n| DEPTH_CHANNELS.iter().any(|w| base(n) == w.to_lowercase()))
+        .cloned()
+        .collect();
+    let size = layer.size;
+    let samples = &layer.channel_data.list[chosen].sample_data;
+    let pixels: Vec<f32> = samples.values_as_f32().collect();
+    if pixels.len() != size.width() * size.height() {
+        return Err(file_error(
+            path,
+            format!(
+                "channel {} is subsampled; ocular needs full resolution",
+                names[chosen]
+            ),
+        ));
+    }
+    Ok((
+        ImageGray {
+            width: size.width() as u32,
+            height: size.height() as u32,
+            pixels,
+        },
+        names[chosen].clone(),
+        candidates,
+    ))
+}
+
+/// Writes linear RGBA as 32-bit float EXR (channels R, G, B, A).
+pub fn write_exr_rgba(path: impl AsRef<Path>, image: &ImageRgba) -> Result<()> {
+    use exr::prelude::*;
+    let path = path.as_ref();
+    check_size(path, image.width, image.height, image.pixels.len())?;
+    let width = image.width as usize;
+    let channels = SpecificChannels::rgba(|position: Vec2<usize>| {
+        let p = image.pixels[position.y() * width + position.x()];
+        (p[0], p[1], p[2], p[3])
+    });
+    let exr_image = Image::from_channels((width, image.height as usize), channels);
+    write_exr_bytes(path, |cursor| {
+        exr_image
+            .write()
+            .to_buffered(cursor)
+            .map_err(|e| format!("cannot encode EXR: {e}"))
+    })
+}
+
+/// Encodes in memory (the EXR writer needs `Seek`), then writes the bytes atomically.
+fn write_exr_bytes<F>(path: &Path, encode: F) -> Result<()>
+where
+    F: FnOnce(&mut std::io::Cursor<Vec<u8>>) -> std::result::Result<(), String>,
+{
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    encode(&mut cursor).map_err(|m| file_error(path, m))?;
+    let bytes = cursor.into_inner();
+    write_atomic(path, |writer| {
+        writer
+            .write_all(&bytes)
+            .map_err(|e| format!("cannot write: {e}"))
+    })
+}
+
+/// Writes one 32-bit float channel named `channel` (use "Z" for depth, the EXR convention).
+pub fn write_exr_gray(path: impl AsRef<Path>, image: &ImageGray, channel: &str) -> Result<()> {
+    use exr::prelude::*;
+    let path = path.as_ref();
+    check_size(path, image.width, image.height, image.pixels.len())?;
+    let width = image.width as usize;
+    let channels = SpecificChannels::build()
+        .with_channel(channel)
+        .with_pixel_fn(
+            |position: Vec2<usize>| (image.pixels[position.y() * width + position.x()],),
+        );
+    let exr_image = Image::from_channels((width, image.height as usize), channels);
+    write_exr_bytes(path, |cursor| {
+        exr_image
+            .write()
+            .to_buffered(cursor)
+            .map_err(|e| format!("cannot encode EXR: {e}"))
+    })
+}
+
+/// Writes depth in metres as a single-channel EXR with the conventional channel name Z.
+pub fn write_exr_depth(path: impl AsRef<Path>, image: &ImageGray) -> Result<()> {
+    write_exr_gray(path, image, "Z")
+}
+
+/// Writes an 8-bit sRGB PNG preview of linear RGB (alpha is dropped).
+pub fn write_png(path: impl AsRef<Path>, image: &ImageRgba, tonemap: Tonemap) -> Result<()> {
+    use image::ImageEncoder;
+    let path = path.as_ref();
+    check_size(path, image.width, image.height, image.pixels.len())?;
+    let mut bytes = Vec::with_capacity(image.pixels.len() * 3);
+    for p in &image.pixels {
+        let rgb = tonemap.apply([p[0], p[1], p[2]]);
+        bytes.extend(rgb.map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8));
+    }
+    write_atomic(path, |writer| {
+        image::codecs::png::PngEncoder::new(writer)
+            .write_image(
+                &bytes,
+                image.width,
+                image.height,
+                image::ExtendedColorType::Rgb8,
+            )
+            .map_err(|e| format!("cannot encode PNG: {e}"))
+    })
+}

@@ -1,0 +1,449 @@
+//! The rasteriser: a scene at one instant → linear HDR colour and metric depth.
+//!
+//! One render pass draws the scene with 4× MSAA into a colour target (resolved by the render
+//! pass to a single-sample RGBA16F image) and a view-depth target (R32F, the distance along
+//! the view direction in metres, written per sample). A compute pass (raster.comp) then
+//! resolves depth with the nearest sample instead of an average, so depth never blends
+//! across an edge. Pixels no object covers get the background colour and depth `far_m`.
+
+use half::f16;
+
+use crate::gpu::{
+    Binding, BindingKind, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
+    GraphicsPipeline, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings, VertexAttribute,
+    VertexFormat,
+};
+use crate::image_io::{ImageGray, ImageRgba};
+use crate::scene::{FrameState, Light, Vertex, MAX_LIGHTS};
+use crate::{Error, Result};
+
+/// Samples per pixel.
+pub const MSAA_SAMPLES: u32 = 4;
+
+/// A rendered frame on the CPU: row-major, top row first.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB (luminance Y in cd/m²) and alpha 1.
+    pub color: Vec<[f32; 4]>,
+    /// Distance along the view direction (camera z), metres.
+    pub depth_m: Vec<f32>,
+    /// GPU time per pass ("raster", "depth resolve", "read back").
+    pub timings: Timings,
+}
+
+impl Frame {
+    pub fn color_image(&self) -> ImageRgba {
+        ImageRgba::new(self.width, self.height, self.color.clone())
+    }
+
+    pub fn depth_image(&self) -> ImageGray {
+        ImageGray::new(self.width, self.height, self.depth_m.clone())
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct LightGpu {
+    position: [f32; 4],
+    rgb: [f32; 4],
+}
+
+/// Mirrors `Frame` in glsl/render/raster_frame.glsl (std140: all members 16-byte aligned).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct FrameUniform {
+    view_proj: [[f32; 4]; 4],
+    view: [[f32; 4]; 4],
+    camera_position: [f32; 4],
+    ambient: [f32; 4],
+    counts: [u32; 4],
+    lights: [LightGpu; MAX_LIGHTS],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct MaterialPush {
+    albedo: [f32; 4],
+    emission: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ResolvePush {
+    width: u32,
+    height: u32,
+    samples: u32,
+}
+
+/// Scene data uploaded once and reused while the same scene is rendered.
+struct GpuScene {
+    scene_id: u64,
+    vertices: Buffer,
+    indices: Buffer,
+    textures: Vec<Image>,
+}
+
+/// Render targets for one frame size.
+struct Targets {
+    width: u32,
+    height: u32,
+    color_ms: Image,
+    depth_ms: Image,
+    view_depth_ms: Image,
+    color: Image,
+    framebuffer: Framebuffer,
+}
+
+pub struct Rasterizer {
+    pipeline: GraphicsPipeline,
+    resolve: ComputePipeline,
+    texture_sampler: Sampler,
+    point_sampler: Sampler,
+    white: Image,
+    scene: Option<GpuScene>,
+    targets: Option<Targets>,
+}
+
+impl Rasterizer {
+    pub fn new(ctx: &Context) -> Result<Rasterizer> {
+        let stride = std::mem::size_of::<Vertex>() as u32;
+        let pipeline = GraphicsPipeline::builder(
+            "raster",
+            crate::shaders::RENDER_RASTER_VERT,
+            crate::shaders::RENDER_RASTER_FRAG,
+        )
+        .vertex_layout(
+            stride,
+            &[
+                VertexAttribute {
+                    location: 0,
+                    format: VertexFormat::Float3,
+                    offset: 0,
+                },
+                VertexAttribute {
+                    location: 1,
+                    format: VertexFormat::Float3,
+                    offset: 12,
+                },
+                VertexAttribute {
+                    location: 2,
+                    format: VertexFormat::Float2,
+                    offset: 24,
+                },
+            ],
+        )
+        .bindings(&[BindingKind::UniformBuffer, BindingKind::SampledImage])
+        .push_constants::<MaterialPush>()
+        .samples(MSAA_SAMPLES)
+        .color_target(TexelFormat::Rgba16Float, true)
+        .color_target(TexelFormat::R32Float, false)
+        .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
+        .build(ctx)?;
+        let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
+            .bindings(&[BindingKind::SampledImage, BindingKind::StorageBuffer])
+            .push_constants::<ResolvePush>()
+            .build(ctx)?;
+        let white = Image::new_2d(
+            ctx,
+            "white texture",
+            1,
+            1,
+            TexelFormat::Rgba8Srgb,
+            ImageUsage::SAMPLED,
+        )?;
+        white.upload(ctx, &[[255u8; 4]])?;
+        Ok(Rasterizer {
+            pipeline,
+            resolve,
+            texture_sampler: Sampler::linear(ctx, Edge::Repeat)?,
+            point_sampler: Sampler::linear(ctx, Edge::ClampToEdge)?,
+            white,
+            scene: None,
+            targets: None,
+        })
+    }
+
+    fn upload_scene(&mut self, ctx: &Context, state: &FrameState<'_>) -> Result<()> {
+        let scene = state.scene;
+        if self.scene.as_ref().map(|s| s.scene_id) == Some(scene.id()) {
+            return Ok(());
+        }
+        self.scene = None;
+        let g = &scene.geometry;
+        let vertices = if g.vertices.is_empty() {
+            Buffer::new(ctx, "scene vertices", 16, Residency::Device)?
+        } else {
+            Buffer::from_slice(ctx, "scene vertices", &g.vertices)?
+        };
+        let indices = if g.indices.is_empty() {
+            Buffer::new(ctx, "scene indices", 16, Residency::Device)?
+        } else {
+            Buffer::from_slice(ctx, "scene indices", &g.indices)?
+        };
+        let mut textures = Vec::with_capacity(g.textures.len());
+        for t in &g.textures {
+            let image = Image::new_2d(
+                ctx,
+                &t.source,
+                t.width,
+                t.height,
+                TexelFormat::Rgba8Srgb,
+                ImageUsage::SAMPLED,
+            )?;
+            image.upload(ctx, &t.rgba8_srgb)?;
+            textures.push(image);
+        }
+        self.scene = Some(GpuScene {
+            scene_id: scene.id(),
+            vertices,
+            indices,
+            textures,
+        });
+        Ok(())
+    }
+
+    fn ensure_targets(&mut self, ctx: &Context, width: u32, height: u32) -> Result<()> {
+        if self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height)
+        {
+            return Ok(());
+        }
+        self.targets = None;
+        let attachment = |depth: bool, sampled: bool, samples: u32| ImageUsage {
+            sampled_linear: sampled,
+            storage: false,
+            color_attachment: !depth,
+            depth_attachment: depth,
+            samples,
+        };
+        let color_ms = Image::new_2d(
+            ctx,
+            "raster colour (MSAA)",
+            width,
+            height,
+            TexelFormat::Rgba16Float,
+            attachment(false, false, MSAA_SAMPLES),
+        )?;
+        let view_depth_ms = Image::new_2d(
+            ctx,
+            "raster view depth (MSAA)",
+            width,
+            height,
+            TexelFormat::R32Float,
+            attachment(false, true, MSAA_SAMPLES),
+        )?;
+        let depth_ms = Image::new_2d(
+            ctx,
+            "raster depth buffer (MSAA)",
+            width,
+            height,
+            TexelFormat::D32Float,
+            attachment(true, false, MSAA_SAMPLES),
+        )?;
+        let color = Image::new_2d(
+            ctx,
+            "raster colour",
+            width,
+            height,
+            TexelFormat::Rgba16Float,
+            attachment(false, false, 1),
+        )?;
+        let framebuffer = self.pipeline.framebuffer(
+            ctx,
+            &[&color_ms, &view_depth_ms],
+            &[&color],
+            Some(&depth_ms),
+        )?;
+        self.targets = Some(Targets {
+            width,
+            height,
+            color_ms,
+            depth_ms,
+            view_depth_ms,
+            color,
+            framebuffer,
+        });
+        Ok(())
+    }
+
+    /// Renders `state` at `width × height` and reads colour and depth back.
+    pub fn render(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        width: u32,
+        height: u32,
+    ) -> Result<Frame> {
+        if width == 0 || height == 0 {
+            return Err(Error::input(format!(
+                "frame size {width}×{height} has no pixels"
+            )));
+        }
+        self.upload_scene(ctx, state)?;
+        self.ensure_targets(ctx, width, height)?;
+        let scene = state.scene;
+        let camera = &state.camera;
+
+        let view = camera.view_matrix();
+        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
+        let mut uniform = FrameUniform {
+            view_proj: (projection * view).as_mat4().to_cols_array_2d(),
+            view: view.as_mat4().to_cols_array_2d(),
+            camera_position: [
+                camera.position_m[0] as f32,
+                camera.position_m[1] as f32,
+                camera.position_m[2] as f32,
+                1.0,
+            ],
+            ambient: [0.0; 4],
+            counts: [0; 4],
+            lights: [LightGpu {
+                position: [0.0; 4],
+                rgb: [0.0; 4],
+            }; MAX_LIGHTS],
+        };
+        let mut count = 0usize;
+        for light in &scene.lights {
+            match *light {
+                Light::Ambient { rgb_lux } => {
+                    for (sum, add) in uniform.ambient.iter_mut().zip(rgb_lux) {
+                        *sum += add;
+                    }
+                }
+                Light::Directional { direction, rgb_lux } => {
+                    uniform.lights[count] = LightGpu {
+                        position: [direction[0], direction[1], direction[2], 0.0],
+                        rgb: [rgb_lux[0], rgb_lux[1], rgb_lux[2], 0.0],
+                    };
+                    count += 1;
+                }
+                Light::Point { position_m, rgb_cd } => {
+                    uniform.lights[count] = LightGpu {
+                        position: [position_m[0], position_m[1], position_m[2], 1.0],
+                        rgb: [rgb_cd[0], rgb_cd[1], rgb_cd[2], 0.0],
+                    };
+                    count += 1;
+                }
+            }
+        }
+        uniform.counts[0] = count as u32;
+        let mut uniform_buffer = Buffer::new(
+            ctx,
+            "raster frame uniforms",
+            std::mem::size_of::<FrameUniform>() as u64,
+            Residency::Upload,
+        )?;
+        uniform_buffer
+            .mapped_bytes_mut()
+            .expect("upload buffers are host-visible")[..std::mem::size_of::<FrameUniform>()]
+            .copy_from_slice(bytemuck::bytes_of(&uniform));
+
+        let pixels = width as usize * height as usize;
+        let depth_readback = Buffer::new(
+            ctx,
+            "raster depth",
+            (pixels * 4) as u64,
+            Residency::Readback,
+        )?;
+        let color_readback = Buffer::new(
+            ctx,
+            "raster colour",
+            (pixels * 8) as u64,
+            Residency::Readback,
+        )?;
+
+        let gpu_scene = self.scene.as_ref().expect("uploaded above");
+        let targets = self.targets.as_ref().expect("created above");
+        let bg = scene.background_rgb;
+        let far = camera.far_m as f32;
+        let materials = &scene.geometry.materials;
+        let timings = ctx.submit(|rec| {
+            rec.begin_pass("raster");
+            rec.begin_render_pass(
+                &self.pipeline,
+                &targets.framebuffer,
+                &[[bg[0], bg[1], bg[2], 1.0], [far, 0.0, 0.0, 0.0]],
+                0.0,
+            )?;
+            for batch in &scene.geometry.batches {
+                let material = &materials[batch.material];
+                let texture = material
+                    .texture
+                    .and_then(|t| gpu_scene.textures.get(t))
+                    .unwrap_or(&self.white);
+                let push = MaterialPush {
+                    albedo: [
+                        material.albedo[0],
+                        material.albedo[1],
+                        material.albedo[2],
+                        if material.texture.is_some() { 1.0 } else { 0.0 },
+                    ],
+                    emission: [
+                        material.emission[0],
+                        material.emission[1],
+                        material.emission[2],
+                        0.0,
+                    ],
+                };
+                rec.draw_indexed(
+                    &self.pipeline,
+                    &[
+                        Binding::Buffer(&uniform_buffer),
+                        Binding::Sampled(texture, &self.texture_sampler),
+                    ],
+                    &push,
+                    &gpu_scene.vertices,
+                    &gpu_scene.indices,
+                    batch.first_index,
+                    batch.index_count,
+                )?;
+            }
+            rec.end_render_pass()?;
+            rec.begin_pass("depth resolve");
+            rec.dispatch(
+                &self.resolve,
+                &[
+                    Binding::Sampled(&targets.view_depth_ms, &self.point_sampler),
+                    Binding::Buffer(&depth_readback),
+                ],
+                &ResolvePush {
+                    width,
+                    height,
+                    samples: MSAA_SAMPLES,
+                },
+                [width.div_ceil(8), height.div_ceil(8), 1],
+            )?;
+            rec.begin_pass("read back");
+            rec.copy_image_to_buffer(&targets.color, &color_readback);
+            Ok(())
+        })?;
+        // Keep the MSAA targets referenced so that nothing reorders their lifetime.
+        let _ = (&targets.color_ms, &targets.depth_ms);
+
+        let halves: Vec<f16> = bytemuck::pod_collect_to_vec(
+            &color_readback
+                .mapped_bytes()
+                .expect("read-back buffers are host-visible")[..pixels * 8],
+        );
+        let color: Vec<[f32; 4]> = halves
+            .chunks_exact(4)
+            .map(|c| [c[0].to_f32(), c[1].to_f32(), c[2].to_f32(), c[3].to_f32()])
+            .collect();
+        let depth_m: Vec<f32> = bytemuck::pod_collect_to_vec(
+            &depth_readback
+                .mapped_bytes()
+                .expect("read-back buffers are host-visible")[..pixels * 4],
+        );
+        Ok(Frame {
+            width,
+            height,
+            color,
+            depth_m,
+            timings,
+        })
+    }
+}

@@ -1,0 +1,269 @@
+//! Triangle geometry in world space, ready for the rasteriser: one vertex and one index array
+//! for the whole scene, cut into batches that share a material. Built-in primitives are
+//! generated here in their local frame and transformed on the CPU once per scene (objects do
+//! not move over time; the camera does).
+
+use glam::{DMat3, DMat4, DVec3};
+
+/// One vertex as the raster shaders read it (`location` 0, 1, 2).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    pub position_m: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+}
+
+/// Lambertian surface: reflectance (linear RGB, 0..1) times an optional texture, plus emitted
+/// luminance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub albedo: [f32; 3],
+    pub texture: Option<usize>,
+    /// Emitted linear RGB whose luminance Y is in cd/m².
+    pub emission: [f32; 3],
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            albedo: [0.8, 0.8, 0.8],
+            texture: None,
+            emission: [0.0; 3],
+        }
+    }
+}
+
+/// An sRGB-encoded RGBA8 texture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    pub rgba8_srgb: Vec<[u8; 4]>,
+    pub source: String,
+}
+
+/// `index_count` indices from `first_index` drawn with one material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Batch {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub material: usize,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Geometry {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+    pub batches: Vec<Batch>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+}
+
+/// A mesh in its local frame before placement.
+#[derive(Clone, Debug, Default)]
+pub struct LocalMesh {
+    pub positions: Vec<[f64; 3]>,
+    pub normals: Vec<[f64; 3]>,
+    pub uvs: Vec<[f64; 2]>,
+    pub indices: Vec<u32>,
+}
+
+impl LocalMesh {
+    fn push(&mut self, p: [f64; 3], n: [f64; 3], uv: [f64; 2]) -> u32 {
+        self.positions.push(p);
+        self.normals.push(n);
+        self.uvs.push(uv);
+        (self.positions.len() - 1) as u32
+    }
+
+    /// Appends another mesh (indices shifted).
+    pub fn append(&mut self, other: &LocalMesh) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.uvs.extend_from_slice(&other.uvs);
+        self.indices.extend(other.indices.iter().map(|i| i + base));
+    }
+
+    /// An axis-aligned rectangle [x0, x1] × [y0, y1] at height z facing +Z.
+    pub fn rect(&mut self, x0: f64, y0: f64, x1: f64, y1: f64, z: f64) {
+        let n = [0.0, 0.0, 1.0];
+        let a = self.push([x0, y0, z], n, [0.0, 1.0]);
+        let b = self.push([x1, y0, z], n, [1.0, 1.0]);
+        let c = self.push([x1, y1, z], n, [1.0, 0.0]);
+        let d = self.push([x0, y1, z], n, [0.0, 0.0]);
+        self.indices.extend_from_slice(&[a, b, c, a, c, d]);
+    }
+
+    /// Planar polygon given as a triangle list of points in the z plane, facing +Z.
+    pub fn flat_triangle(&mut self, p: [[f64; 2]; 3], z: f64) {
+        let n = [0.0, 0.0, 1.0];
+        for q in p {
+            let i = self.push([q[0], q[1], z], n, [q[0], -q[1]]);
+            self.indices.push(i);
+        }
+    }
+}
+
+/// A `width × height` rectangle in the local XY plane, centred, facing +Z.
+pub fn plane(width: f64, height: f64) -> LocalMesh {
+    let mut m = LocalMesh::default();
+    m.rect(-width / 2.0, -height / 2.0, width / 2.0, height / 2.0, 0.0);
+    m
+}
+
+/// A box centred at the origin.
+pub fn cuboid(size: [f64; 3]) -> LocalMesh {
+    let h = size.map(|s| s / 2.0);
+    let mut m = LocalMesh::default();
+    // Each face: normal axis, sign; the two in-plane axes follow the right-hand rule so that
+    // every face is wound counter-clockwise seen from outside.
+    for axis in 0..3 {
+        for sign in [1.0, -1.0] {
+            let u_axis = (axis + 1) % 3;
+            let v_axis = (axis + 2) % 3;
+            let mut n = [0.0; 3];
+            n[axis] = sign;
+            let corner = |su: f64, sv: f64| {
+                let mut p = [0.0; 3];
+                p[axis] = sign * h[axis];
+                p[u_axis] = su * h[u_axis];
+                p[v_axis] = sv * h[v_axis];
+                p
+            };
+            let quad = if sign > 0.0 {
+                [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            } else {
+                [(-1.0, -1.0), (-1.0, 1.0), (1.0, 1.0), (1.0, -1.0)]
+            };
+            let ids: Vec<u32> = quad
+                .iter()
+                .map(|&(su, sv)| m.push(corner(su, sv), n, [(su + 1.0) / 2.0, (1.0 - sv) / 2.0]))
+                .collect();
+            m.indices
+                .extend_from_slice(&[ids[0], ids[1], ids[2], ids[0], ids[2], ids[3]]);
+        }
+    }
+    m
+}
+
+/// A UV sphere: `segments` around the Y axis, `segments / 2` rings from pole to pole.
+pub fn sphere(radius: f64, segments: u32) -> LocalMesh {
+    let segments = segments.max(8);
+    let rings = (segments / 2).max(4);
+    let mut m = LocalMesh::default();
+    for r in 0..=rings {
+        let v = f64::from(r) / f64::from(rings);
+        let theta = v * std::f64::consts::PI;
+        for s in 0..=segments {
+            let u = f64::from(s) / f64::from(segments);
+            let phi = u * std::f64::consts::TAU;
+            let n = [
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                theta.sin() * phi.cos(),
+            ];
+            m.push(n.map(|c| c * radius), n, [u, v]);
+        }
+    }
+    let stride = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let a = r * stride + s;
+            let b = a + stride;
+            m.indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
+        }
+    }
+    m
+}
+
+/// A closed cylinder along local Y, centred at the origin.
+pub fn cylinder(radius: f64, height: f64, segments: u32) -> LocalMesh {
+    let segments = segments.max(6);
+    let mut m = LocalMesh::default();
+    let h = height / 2.0;
+    for s in 0..=segments {
+        let u = f64::from(s) / f64::from(segments);
+        let phi = u * std::f64::consts::TAU;
+        let n = [phi.sin(), 0.0, phi.cos()];
+        m.push([radius * n[0], -h, radius * n[2]], n, [u, 1.0]);
+        m.push([radius * n[0], h, radius * n[2]], n, [u, 0.0]);
+    }
+    for s in 0..segments {
+        let a = 2 * s;
+        m.indices
+            .extend_from_slice(&[a, a + 2, a + 1, a + 1, a + 2, a + 3]);
+    }
+    for (y, ny) in [(h, 1.0), (-h, -1.0)] {
+        let n = [0.0, ny, 0.0];
+        let centre = m.push([0.0, y, 0.0], n, [0.5, 0.5]);
+        let first = m.positions.len() as u32;
+        for s in 0..=segments {
+            let phi = f64::from(s) / f64::from(segments) * std::f64::consts::TAU;
+            let (x, z) = (phi.sin(), phi.cos());
+            m.push(
+                [radius * x, y, radius * z],
+                n,
+                [0.5 + 0.5 * x, 0.5 - 0.5 * z],
+            );
+        }
+        for s in 0..segments {
+            let (a, b) = (first + s, first + s + 1);
+            if ny > 0.0 {
+                m.indices.extend_from_slice(&[centre, a, b]);
+            } else {
+                m.indices.extend_from_slice(&[centre, b, a]);
+            }
+        }
+    }
+    m
+}
+
+/// Translation · rotation (about X, then Y, then Z, degrees) · scale.
+pub fn model_matrix(translate: [f64; 3], rotate_deg: [f64; 3], scale: [f64; 3]) -> DMat4 {
+    let r = DMat4::from_rotation_z(rotate_deg[2].to_radians())
+        * DMat4::from_rotation_y(rotate_deg[1].to_radians())
+        * DMat4::from_rotation_x(rotate_deg[0].to_radians());
+    DMat4::from_translation(DVec3::from(translate)) * r * DMat4::from_scale(DVec3::from(scale))
+}
+
+impl Geometry {
+    /// Places `mesh` with `model` and draws it with `material` (an index into `materials`).
+    pub fn add(&mut self, mesh: &LocalMesh, model: &DMat4, material: usize) {
+        if mesh.indices.is_empty() {
+            return;
+        }
+        let normal_matrix = DMat3::from_mat4(*model).inverse().transpose();
+        let base = self.vertices.len() as u32;
+        for i in 0..mesh.positions.len() {
+            let p = model.transform_point3(DVec3::from(mesh.positions[i]));
+            let n = (normal_matrix * DVec3::from(mesh.normals[i])).normalize_or_zero();
+            self.vertices.push(Vertex {
+                position_m: p.as_vec3().to_array(),
+                normal: n.as_vec3().to_array(),
+                uv: mesh.uvs[i].map(|c| c as f32),
+            });
+        }
+        let first_index = self.indices.len() as u32;
+        self.indices.extend(mesh.indices.iter().map(|i| i + base));
+        let index_count = mesh.indices.len() as u32;
+        match self.batches.last_mut() {
+            Some(last)
+                if last.material == material
+                    && last.first_index + last.index_count == first_index =>
+            {
+                last.index_count += index_count;
+            }
+            _ => self.batches.push(Batch {
+                first_index,
+                index_count,
+                material,
+            }),
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}

@@ -1,0 +1,92 @@
+//! The depth-slice baseline against the ground truth and the splat runtime on a layered scene:
+//! it handles occlusion only at slice boundaries, so it must be clearly worse than splatting.
+
+mod common;
+
+use common::synthetic::{ExactSynthetic, SyntheticEye};
+use ocular::metrics::{psnr, ssim, ImageView};
+use ocular::psf::kernels::DioptreAxis;
+use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
+use ocular::render::{reference, slices};
+
+#[test]
+fn slices_are_finite_and_clearly_worse_than_splatting() {
+    let (w, h) = (160usize, 90usize);
+    let mut color = Vec::new();
+    let mut depth = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let t = [
+                (0.21 * x as f32).sin(),
+                (0.17 * y as f32).cos(),
+                (0.09 * (x + y) as f32).sin(),
+            ];
+            let c = t.map(|v| 0.5 + 0.45 * v);
+            let d = if (60..110).contains(&x) && (20..60).contains(&y) {
+                1.0 / 3.0
+            } else if (20..80).contains(&x) && (40..80).contains(&y) {
+                1.0 / 1.5
+            } else {
+                1.0 / 0.4
+            };
+            color.push([c[0], c[1], c[2], 1.0]);
+            depth.push(d);
+        }
+    }
+    let input = FrameInput {
+        width: w as u32,
+        height: h as u32,
+        color: &color,
+        depth_m: &depth,
+    };
+    let eye = SyntheticEye::new(0.4, 3.0);
+    let objects = DioptreAxis::spanning(0.0, 4.0, 33);
+    let max_radius = 12;
+    let exact = ExactSynthetic {
+        eye: eye.clone(),
+        pupil_mm: 4.0,
+        max_radius,
+    };
+    let truth = reference::render(&input, &exact);
+    let sliced = slices::render(&input, &exact, slices::DEFAULT_SLICES);
+    assert!(sliced.iter().all(|p| p.iter().all(|v| v.is_finite())));
+
+    let ctx = common::gpu();
+    let mut splatter = Splatter::new(
+        &ctx,
+        eye.grid(objects, max_radius, &[4.0], 90),
+        SplatSettings::default(),
+    )
+    .unwrap();
+    let splat = splatter
+        .render(
+            &input,
+            ViewState {
+                pupil_mm: 4.0,
+                focus_d: 0.4,
+            },
+            false,
+        )
+        .unwrap()
+        .color;
+
+    fn v(p: &[[f32; 4]]) -> ImageView<'_> {
+        ImageView::new(160, 90, p)
+    }
+    let (db_splat, db_slices) = (
+        psnr(v(&splat), v(&truth), 1.0),
+        psnr(v(&sliced), v(&truth), 1.0),
+    );
+    let (s_splat, s_slices) = (
+        ssim(v(&splat), v(&truth), 1.0).mean,
+        ssim(v(&sliced), v(&truth), 1.0).mean,
+    );
+    eprintln!("vs ground truth: splat {db_splat:.2} dB / SSIM {s_splat:.4}; slices {db_slices:.2} dB / SSIM {s_slices:.4}");
+    assert!(db_splat >= 45.0 && s_splat >= 0.99);
+    assert!(
+        db_slices < db_splat - 5.0,
+        "slices {db_slices:.2} dB should be clearly below splat {db_splat:.2} dB"
+    );
+    drop(splatter);
+    common::finish(ctx);
+}
