@@ -185,7 +185,7 @@ impl ColumnOptics {
         let distance = distance_of(focus_d);
         let acc = accommodate(eye, distance, pupil_mm, settings.accommodation_nm).map_err(|e| {
             Error::input(format!(
-                "focus-d {focus_d} D at pupil {pupil_mm} mm: the eye cannot focus there ({e})"
+                "cannot focus the eye at focus-d {focus_d} D with pupils-mm {pupil_mm}: {e}"
             ))
         })?;
         let (focused, beyond) =
@@ -203,7 +203,13 @@ impl ColumnOptics {
                 pupil_mm,
                 distance,
                 settings.zernike_order,
-            )?;
+            )
+            .map_err(|e| {
+                Error::input(format!(
+                    "cannot measure the eye at pupils-mm {pupil_mm}, {wavelength_nm} nm, \
+                     focus-d {focus_d} D: {e}"
+                ))
+            })?;
             let e = m.entrance_pupil_z_mm * 1e-3;
             channels.push(ChannelOptics::from_wavefront(
                 &m.coefficients_um,
