@@ -1,5 +1,6 @@
 //! PSF grid precomputation timings (run: `cargo bench --bench kernels`; `-- --quick` skips
-//! the full grids). The seed paper's grid: 41 objects × 5 focus × 4 pupils × 3 wavelengths =
+//! the full grids, and so does `cargo test`, which runs this without `--bench` as a smoke
+//! test). The seed paper's grid: 41 objects × 5 focus × 4 pupils × 3 wavelengths =
 //! 2460 PSFs, Rmax 48 (here 720 px over a 30° field: the natural radii reach past 48 and are
 //! capped, as the paper's 48 is at 720p), and a single-frame column of 123 PSFs.
 //! The eyes are the hand-derived stand-ins of `eye::test_eyes` (no estimated presets yet).
@@ -27,7 +28,8 @@ fn run(eye_name: &str, axes: &GridAxes) -> (f64, GridReport) {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick") || !args.iter().any(|a| a == "--bench");
     println!(
         "# PSF grid precomputation ({} threads, {})",
         rayon::current_num_threads(),
@@ -36,25 +38,23 @@ fn main() {
     println!("| eye | grid | PSFs | seconds | optics s | PSFs s | kernels s | Rmax (natural) | MiB per (focus, pupil) | worst β truncation |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for eye in ["myopia-like", "keratoconus-like"] {
-        let mut cases = vec![
-            (
-                "column, pupil 4 mm, focus 0.125 D",
-                GridAxes {
-                    focus_d: vec![0.125],
-                    pupils_mm: vec![4.0],
-                    ..GridAxes::default()
-                },
-            ),
-            (
+        let mut cases = vec![(
+            "column, pupil 4 mm, focus 0.125 D",
+            GridAxes {
+                focus_d: vec![0.125],
+                pupils_mm: vec![4.0],
+                ..GridAxes::default()
+            },
+        )];
+        if !quick {
+            cases.push((
                 "column, pupil 7 mm, focus 0.125 D",
                 GridAxes {
                     focus_d: vec![0.125],
                     pupils_mm: vec![7.0],
                     ..GridAxes::default()
                 },
-            ),
-        ];
-        if !quick {
+            ));
             cases.push(("full (paper)", GridAxes::default()));
         }
         for (label, axes) in cases {

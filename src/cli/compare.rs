@@ -148,7 +148,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         height_px: height,
     };
     let mut options = KernelOptions::default();
-    options.reference_axes.objects = crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
+    options.reference_axes.objects =
+        crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
     options.settings.max_radius_cap = args.rmax_cap;
     options.settings.max_beta_degree = args.beta_degree;
     options.settings.sample_um = args.sample_um;

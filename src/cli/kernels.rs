@@ -4,12 +4,11 @@
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Mutex;
 use std::time::Instant;
 
-use crate::eye::test_eyes::{test_eye, TEST_EYE_NAMES};
-use crate::eye::{presets::PRESET_NAMES, Eye};
+use crate::eye::Eye;
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
 use crate::psf::cache::{cached, default_cache_dir, grid_key, write_grid, CacheOutcome};
 use crate::psf::grid::{compute_grid, GridReport, Stage};
@@ -74,18 +73,7 @@ pub struct KernelsArgs {
 
 /// An eye from a TOML file or a preset / test-eye name.
 pub fn load_eye(spec: &str) -> Result<Eye> {
-    let path = Path::new(spec);
-    if path.is_file() {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, e))?;
-        return Eye::from_toml_str(&text).map_err(|e| Error::file(path, e));
-    }
-    Eye::preset(spec).or_else(|| test_eye(spec)).ok_or_else(|| {
-        Error::input(format!(
-            "--eye {spec:?}: no such file or preset; presets: {}, {}",
-            PRESET_NAMES.join(", "),
-            TEST_EYE_NAMES.join(", ")
-        ))
-    })
+    super::render::load_eye(spec)
 }
 
 fn parse_list(option: &str, text: &str) -> Result<Vec<f64>> {

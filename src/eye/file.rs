@@ -84,6 +84,13 @@ pub fn resolve(spec: &str) -> crate::Result<EyeFile> {
     if let Some(f) = preset(spec) {
         return Ok(f);
     }
+    // The hand-made eyes of the kernel benchmarks are accepted too, but not advertised.
+    if let Some(eye) = super::test_eyes::test_eye(spec) {
+        return Ok(EyeFile {
+            eye,
+            estimate: None,
+        });
+    }
     let path = Path::new(spec);
     if !path.exists() {
         return Err(crate::Error::input(format!(

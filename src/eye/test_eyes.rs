@@ -43,3 +43,31 @@ pub fn keratoconus_like() -> Eye {
     .collect();
     e
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eye::measure;
+
+    fn refraction(eye: &Eye, pupil_mm: f64) -> (f64, f64, f64) {
+        let sys = eye.system().unwrap();
+        let m = measure(&sys, 549.0, pupil_mm, None, 6).unwrap();
+        let coma = m.coefficient_um(3, -1).hypot(m.coefficient_um(3, 1));
+        let astig = m.coefficient_um(2, -2).hypot(m.coefficient_um(2, 2));
+        (m.refraction.m, coma, astig)
+    }
+
+    #[test]
+    fn test_eyes_have_the_intended_errors() {
+        let (m, _, _) = refraction(&test_eye("myopia-like").unwrap(), 4.0);
+        assert!((-7.0..=-5.5).contains(&m), "myopia-like: {m} D");
+        let (m, _, _) = refraction(&test_eye("myopia10-like").unwrap(), 4.0);
+        assert!((-11.0..=-9.0).contains(&m), "myopia10-like: {m} D");
+        // the seed paper's keratoconus preset (5 mm): coma ≈ 0.6 µm, astigmatism ≈ 0.3 µm,
+        // about −3 D
+        let (m, coma, astig) = refraction(&test_eye("keratoconus-like").unwrap(), 5.0);
+        assert!((-4.5..=-2.0).contains(&m), "keratoconus-like: {m} D");
+        assert!((0.4..=1.0).contains(&coma), "coma {coma} µm");
+        assert!((0.15..=0.6).contains(&astig), "astigmatism {astig} µm");
+    }
+}

@@ -46,7 +46,7 @@ pub struct ChannelOptics {
     pub entrance_pupil_m: f64,
     /// Measured wavefront without piston, tilt and c(2,0) (OSA, µm).
     pub alpha_um: Vec<f64>,
-    /// The expanded residual pupil (β; its own defocus and tilt are zero: f carries defocus).
+    /// β of the residual wavefront (defocus and tilt excluded; f is added per object).
     pub pupil: Pupil,
     /// Ray displacement of the residual wavefront, ∇W/λ (λ/NA), at pupil points (x, y).
     slopes: Vec<([f64; 2], [f64; 2])>,
@@ -68,6 +68,7 @@ impl ChannelOptics {
         for j in [0, 1, 2, 4] {
             alpha_um[j] = 0.0;
         }
+        let t0 = std::time::Instant::now();
         let beta = beta_from_alpha(
             &alpha_um,
             wavelength_nm,
@@ -105,7 +106,7 @@ impl ChannelOptics {
                 pupil_diameter_mm: pupil_mm,
                 wavelength_nm,
                 stiles_crawford: None,
-                seconds: 0.0,
+                seconds: t0.elapsed().as_secs_f64(),
             },
             slopes,
         }
@@ -184,7 +185,7 @@ impl ColumnOptics {
         let distance = distance_of(focus_d);
         let acc = accommodate(eye, distance, pupil_mm, settings.accommodation_nm).map_err(|e| {
             Error::input(format!(
-                "focus-d {focus_d} D at pupil {pupil_mm} mm: the eye cannot focus there ({e})"
+                "cannot focus the eye at focus-d {focus_d} D with pupils-mm {pupil_mm}: {e}"
             ))
         })?;
         let (focused, beyond) =
@@ -202,7 +203,13 @@ impl ColumnOptics {
                 pupil_mm,
                 distance,
                 settings.zernike_order,
-            )?;
+            )
+            .map_err(|e| {
+                Error::input(format!(
+                    "cannot measure the eye at pupils-mm {pupil_mm}, {wavelength_nm} nm, \
+                     focus-d {focus_d} D: {e}"
+                ))
+            })?;
             let e = m.entrance_pupil_z_mm * 1e-3;
             channels.push(ChannelOptics::from_wavefront(
                 &m.coefficients_um,

@@ -136,16 +136,6 @@ fn line(img: &mut RgbImage, (x0, y0): (f64, f64), (x1, y1): (f64, f64), c: Rgb<u
     }
 }
 
-fn dashed(img: &mut RgbImage, a: (f64, f64), b: (f64, f64), c: Rgb<u8>) {
-    let n = 40;
-    for i in (0..n).step_by(2) {
-        let t0 = i as f64 / n as f64;
-        let t1 = (i + 1) as f64 / n as f64;
-        let p = |t: f64| (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
-        line(img, p(t0), p(t1), c, 2);
-    }
-}
-
 /// The set shown: the largest pupil at the nearest-to-far focus (the most blur).
 fn shown_set(grid: &KernelGrid) -> usize {
     (grid.pupils_mm.len() - 1) * grid.focus_d.len()
@@ -311,10 +301,9 @@ pub fn size_plot(grid: &KernelGrid) -> RgbImage {
             for k in 1..o.count {
                 let a = (px(o.value_d(k - 1)), py(set.radius_px[k - 1][c] as f64));
                 let b = (px(o.value_d(k)), py(set.radius_px[k][c] as f64));
-                if fi == 0 {
+                // the second focus state dashed: every other segment
+                if fi == 0 || k % 2 == 1 {
                     line(&mut img, a, b, color, 2);
-                } else {
-                    dashed(&mut img, a, b, color);
                 }
             }
         }

@@ -125,16 +125,20 @@ impl CroppedPsf {
         // Binning into whole pixels moves the first moment by up to half a pixel when the PSF
         // is narrow; a bilinear sub-pixel shift (mass-preserving) puts it back where the
         // samples inside the window have it.
-        let (tx, mx) = axis_moments(&wx, n, side_out, radius, scale, false);
+        let (_, mx) = axis_moments(&wx, n, side_out, radius, scale, false);
         let (ty, my) = axis_moments(&wy, n, side_out, radius, scale, true);
         let (mut m, mut xm, mut ym) = (0.0, 0.0, 0.0);
         for q in 0..n {
-            for c in 0..n {
-                let v = f64::from(self.values[q * n + c]);
-                m += v * ty[q] * tx[c];
-                xm += v * ty[q] * mx[c];
-                ym += v * my[q] * tx[c];
+            if ty[q] == 0.0 && my[q] == 0.0 {
+                continue;
             }
+            let row = &self.values[q * n..(q + 1) * n];
+            // Σ_c v·tx[c] is the row's total after the x pass
+            let a: f64 = tmp[q * side_out..(q + 1) * side_out].iter().sum();
+            let b: f64 = row.iter().zip(&mx).map(|(v, w)| f64::from(*v) * w).sum();
+            m += ty[q] * a;
+            xm += ty[q] * b;
+            ym += my[q] * a;
         }
         if m > 0.0 && m.is_finite() {
             let (gx, gy) = first_moment(&out, side_out);
