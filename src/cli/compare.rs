@@ -15,6 +15,7 @@ use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
 use crate::psf::axes::Screen;
 use crate::render::frame::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+    RenderedFrame,
 };
 use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
 use crate::render::Rasterizer;
@@ -67,6 +68,16 @@ pub struct CompareArgs {
     /// PSF sample size on the retina in µm (the seed paper's 4).
     #[arg(long, default_value_t = 4.0)]
     pub sample_um: f64,
+    /// Save the ground truth (linear EXR) for later runs.
+    #[arg(long, value_name = "FILE.exr")]
+    pub truth_out: Option<PathBuf>,
+    /// Use this ground truth (from --truth-out with the same scene, size, eye and state)
+    /// instead of rendering it: sweeps keep one truth while the settings vary.
+    #[arg(long, value_name = "FILE.exr")]
+    pub truth_in: Option<PathBuf>,
+    /// Skip the slice method.
+    #[arg(long)]
+    pub no_slices: bool,
     /// Write the results as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -86,6 +97,8 @@ pub struct MethodResult {
     pub psnr_db: f64,
     pub mssim: f64,
     pub speedup_vs_reference: f64,
+    /// GPU time of all passes (splat only).
+    pub gpu_ms: Option<f64>,
 }
 
 #[derive(serde::Serialize)]
@@ -172,11 +185,38 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         depth_m: &frame.depth_m,
     };
 
-    let truth = renderer.render(&input, eye_state, Method::Reference)?;
+    let truth = match &args.truth_in {
+        Some(path) => {
+            let image = image_io::read_exr_rgba(path)?;
+            if (image.width, image.height) != (width, height) {
+                return Err(Error::input(format!(
+                    "--truth-in {} is {}×{}, the frame is {width}×{height}",
+                    path.display(),
+                    image.width,
+                    image.height
+                )));
+            }
+            RenderedFrame {
+                color: image.pixels,
+                method: Method::Reference,
+                seconds: f64::NAN,
+                timings: None,
+                stats: None,
+            }
+        }
+        None => renderer.render(&input, eye_state, Method::Reference)?,
+    };
+    if let Some(path) = &args.truth_out {
+        image_io::write_exr_rgba(path, &ImageRgba::new(width, height, truth.color.clone()))?;
+    }
     // The first splat frame compiles shaders and uploads the kernels: time the second.
     renderer.render(&input, eye_state, Method::Splat)?;
     let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
-    let slices_frame = renderer.render(&input, eye_state, Method::Slices)?;
+    let slices_frame = if args.no_slices {
+        None
+    } else {
+        Some(renderer.render(&input, eye_state, Method::Slices)?)
+    };
 
     let (w, h) = (width as usize, height as usize);
     // Compare what a person sees: every image at the input frame's automatic exposure.
@@ -186,7 +226,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let truth01 = exposed(&truth.color, scale);
     let mut methods = Vec::new();
     let mut maps = Vec::new();
-    for frame in [&truth, &splat_frame, &slices_frame] {
+    let frames: Vec<&RenderedFrame> = [Some(&truth), Some(&splat_frame), slices_frame.as_ref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    for frame in frames.iter().copied() {
         let image = exposed(&frame.color, scale);
         let quality = ssim(
             ImageView::new(w, h, &image),
@@ -203,6 +247,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             ),
             mssim: quality.mean,
             speedup_vs_reference: truth.seconds / frame.seconds.max(1e-12),
+            gpu_ms: frame.timings.as_ref().map(|t| t.total_ms()),
         });
         maps.push(quality.map);
     }
@@ -230,22 +275,23 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     if let Some(dir) = &args.maps {
         std::fs::create_dir_all(dir)
             .map_err(|e| Error::file(dir, format!("cannot create: {e}")))?;
-        let tonemap = Tonemap {
+        let shown = Tonemap {
+            exposure_ev,
+            mode: TonemapMode::Clamp,
+        };
+        for frame in &frames {
+            let name = match frame.method {
+                Method::Reference => "truth",
+                m => m.name(),
+            };
+            let image = ImageRgba::new(width, height, frame.color.clone());
+            image_io::write_png(dir.join(format!("{name}.png")), &image, shown)?;
+        }
+        let flat = Tonemap {
             exposure_ev: 0.0,
             mode: TonemapMode::Clamp,
         };
-        for (name, frame) in [
-            ("truth", &truth),
-            ("splat", &splat_frame),
-            ("slices", &slices_frame),
-        ] {
-            image_io::write_png(
-                dir.join(format!("{name}.png")),
-                &ImageRgba::new(width, height, frame.color.clone()),
-                tonemap,
-            )?;
-        }
-        for (name, map) in [("ssim_splat", &maps[1]), ("ssim_slices", &maps[2])] {
+        for (name, map) in ["ssim_splat", "ssim_slices"].iter().zip(&maps[1..]) {
             let rgb: Vec<[f32; 4]> = ssim_false_colour(map, 0.9)
                 .iter()
                 .map(|p| [0, 1, 2].map(|c| image_io::srgb_decode(p[c])))
@@ -254,7 +300,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             image_io::write_png(
                 dir.join(format!("{name}.png")),
                 &ImageRgba::new(width, height, rgb),
-                tonemap,
+                flat,
             )?;
         }
         println!(
