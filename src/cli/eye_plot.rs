@@ -49,7 +49,7 @@ pub fn svg(terms: &[TermFit], r: &Report) -> String {
     let _ = writeln!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
     let _ = writeln!(
         s,
-        r#"<text x="{LEFT}" y="18" font-size="14">Zernike coefficients (µm), {} mm pupil, {} nm: input (grey) vs achieved (blue); RMS error {:.4} µm</text>"#,
+        r#"<text x="10" y="18" font-size="14">Zernike coefficients (µm), {} mm pupil, {} nm: input (grey) vs achieved (blue); RMS error {:.4} µm</text>"#,
         r.pupil_mm, r.wavelength_nm, r.rms_error_um
     );
     let mut v = -vmax;
