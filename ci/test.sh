@@ -12,4 +12,5 @@ fi
 # A missing validation layer must fail the tests, not silently skip the checks.
 export OCULAR_VALIDATION=required
 
-cargo test --release --all-targets "$@"
+# Library, binary and integration tests; benchmarks are built by clippy and run by `cargo bench`.
+cargo test --release "$@"
