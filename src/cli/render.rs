@@ -207,8 +207,13 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
     })
 }
 
+/// The eye named by `--eye` (a preset or a file); errors name the option.
 pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
-    Ok(crate::eye::file::resolve(spec)?.eye)
+    match crate::eye::file::resolve(spec) {
+        Ok(file) => Ok(file.eye),
+        Err(Error::Input(message)) => Err(Error::Input(format!("--eye: {message}"))),
+        Err(other) => Err(other),
+    }
 }
 
 fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
