@@ -21,6 +21,9 @@ layout(binding = 5, rgba32f) writeonly uniform image2D color_out;
 layout(constant_id = 0) const uint TILE = 8u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
+// The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
+// reads 16 bytes instead of the whole 48-byte fragment.
+shared vec4 batch_reach[64];   // centre.xy, reach, unused
 shared Fragment batch[64];
 
 // RGB kernel values at integer radius r (divided by the (2r+1)² storage scale).
@@ -87,18 +90,20 @@ void main() {
 
     for (uint start = 0u; start < n; start += 64u) {
         if (start + local_index < n) {
-            batch[local_index] = fragments[entries[base + start + local_index].y];
+            Fragment f = fragments[entries[base + start + local_index].y];
+            batch[local_index] = f;
+            batch_reach[local_index] = vec4(f.center, fragment_reach(f), 0.0);
         }
         barrier();
         uint batch_size = min(64u, n - start);
         for (uint j = 0u; j < batch_size; j++) {
-            Fragment f = batch[j];
-            float reach = fragment_reach(f);
+            vec4 g = batch_reach[j];
             for (uint q = 0u; q < PIXELS; q++) {
-                vec2 d = centre[q] - f.center;
-                if (abs(d.x) > reach || abs(d.y) > reach) {
+                vec2 d = centre[q] - g.xy;
+                if (abs(d.x) > g.z || abs(d.y) > g.z) {
                     continue;
                 }
+                Fragment f = batch[j];
                 vec3 w = fragment_weight(f, d);
                 C[q] += (vec3(1.0) - A[q]) * w * f.color;
                 A[q] += (vec3(1.0) - A[q]) * w;
