@@ -12,13 +12,10 @@ use super::Cli;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
 use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
-use crate::psf::axes::Screen;
 use crate::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
-    RenderedFrame,
+    dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method, RenderedFrame,
 };
 use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
-use crate::render::Rasterizer;
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -141,36 +138,16 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
-    let state = scene.at_time(0.0);
     let (width, height) = args.size;
-    let frame = Rasterizer::new(&ctx)?.render(&ctx, &state, width, height)?;
-    let focus_d = if state.focus_m.is_finite() && state.focus_m > 0.0 {
-        1.0 / state.focus_m
-    } else {
-        0.0
-    };
-    let pupil_mm = args.pupil_mm.or(state.pupil_mm).unwrap_or(5.0);
-    if !(1.0..=9.0).contains(&pupil_mm) {
-        return Err(Error::input(format!(
-            "--pupil-mm {pupil_mm} is outside 1–9 mm"
-        )));
-    }
-    let eye_state = EyeState { focus_d, pupil_mm };
-    let screen = Screen {
-        fov_y_deg: state.camera.fov_y_deg,
-        height_px: height,
-    };
-    let mut options = KernelOptions::default();
+    let (frame, eye_state, screen) =
+        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
+    let (focus_d, pupil_mm) = (eye_state.focus_d, eye_state.pupil_mm);
+    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     options.reference_axes.objects =
         crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
     options.settings.max_radius_cap = args.rmax_cap;
     options.settings.max_beta_degree = args.beta_degree;
     options.settings.sample_um = args.sample_um;
-    if args.no_cache {
-        options.cache_dir = None;
-    } else if let Some(dir) = &args.cache {
-        options.cache_dir = Some(dir.clone());
-    }
     let kernels = prepare_kernels(
         &eye,
         &scene_needs(&[dioptre_range(&frame.depth_m)], &[eye_state], screen),

@@ -83,6 +83,56 @@ pub fn run(cli: Cli) -> Result<()> {
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
 /// reader never sees a partial file and a failed run leaves no file behind.
+/// Kernel options honouring `--cache DIR` and `--no-cache`.
+pub(crate) fn kernel_options(
+    cache: Option<&std::path::PathBuf>,
+    no_cache: bool,
+) -> crate::render::frame::KernelOptions {
+    let mut options = crate::render::frame::KernelOptions::default();
+    if no_cache {
+        options.cache_dir = None;
+    } else if let Some(dir) = cache {
+        options.cache_dir = Some(dir.clone());
+    }
+    options
+}
+
+/// A scene rasterised at t = 0 with the eye state the measuring commands (bench, compare)
+/// use: the scene's focus, and the given pupil, else the scene's, else the seed paper's 5 mm.
+pub(crate) fn measured_scene_frame(
+    ctx: &crate::gpu::Context,
+    scene: &crate::scene::Scene,
+    (width, height): (u32, u32),
+    pupil_mm: Option<f64>,
+) -> Result<(
+    crate::render::Frame,
+    crate::render::frame::EyeState,
+    crate::psf::axes::Screen,
+)> {
+    let state = scene.at_time(0.0);
+    let frame = crate::render::Rasterizer::new(ctx)?.render(ctx, &state, width, height)?;
+    let focus_d = if state.focus_m.is_finite() && state.focus_m > 0.0 {
+        1.0 / state.focus_m
+    } else {
+        0.0
+    };
+    let pupil_mm = pupil_mm.or(state.pupil_mm).unwrap_or(5.0);
+    if !(1.0..=9.0).contains(&pupil_mm) {
+        return Err(crate::Error::input(format!(
+            "--pupil-mm {pupil_mm} is outside 1–9 mm"
+        )));
+    }
+    let screen = crate::psf::axes::Screen {
+        fov_y_deg: state.camera.fov_y_deg,
+        height_px: height,
+    };
+    Ok((
+        frame,
+        crate::render::frame::EyeState { focus_d, pupil_mm },
+        screen,
+    ))
+}
+
 pub(crate) fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     crate::image_io::write_atomic(path, |w| {
         std::io::Write::write_all(w, bytes).map_err(|e| format!("cannot write: {e}"))

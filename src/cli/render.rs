@@ -14,7 +14,7 @@ use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
 use crate::psf::cache::CacheOutcome;
 use crate::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, Method,
 };
 use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
 use crate::render::Rasterizer;
@@ -371,12 +371,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         height_px: input.height,
     };
     let needs = scene_needs(&[dioptre_range(&input.depth_m)], &[state], screen);
-    let mut options = KernelOptions::default();
-    if args.no_cache {
-        options.cache_dir = None;
-    } else if let Some(dir) = &args.cache {
-        options.cache_dir = Some(dir.clone());
-    }
+    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let kernels = prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
     let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);

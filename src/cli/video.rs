@@ -21,7 +21,7 @@ use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
 use crate::optics::pupil::{watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
 use crate::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, Method,
 };
 use crate::render::splat::{FrameInput, SplatSettings};
 use crate::render::{Frame, Rasterizer};
@@ -308,12 +308,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         });
     }
     let needs = scene_needs(&ranges, &states, screen);
-    let mut options = KernelOptions::default();
-    if args.no_cache {
-        options.cache_dir = None;
-    } else if let Some(dir) = &args.cache {
-        options.cache_dir = Some(dir.clone());
-    }
+    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let mut renderers = Vec::new();
     for (_, eye) in &eyes {
         let kernels = prepare_kernels(eye, &needs, &options)?;
