@@ -13,7 +13,7 @@ use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
 use crate::render::frame::{dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method};
-use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
+use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -136,18 +136,14 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     if args.frames == 0 {
         return Err(Error::input("--frames must be at least 1"));
     }
-    let splat = SplatSettings {
-        tile_size: args.tile_size,
-        texture_format: args.texture_format,
-        merge: MergeSettings {
+    let splat = super::splat_settings(
+        args.tile_size,
+        args.texture_format,
+        MergeSettings {
             levels: args.merge_levels,
             ..MergeSettings::default()
         },
-        ..SplatSettings::default()
-    };
-    splat
-        .validate()
-        .map_err(|e| Error::input(format!("--tile-size / --merge-levels: {e}")))?;
+    )?;
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;

@@ -15,7 +15,7 @@ use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
 use crate::render::frame::{
     dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method, RenderedFrame,
 };
-use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
+use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -120,18 +120,16 @@ fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
 }
 
 pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
-    let splat = SplatSettings {
-        tile_size: args.tile_size,
-        texture_format: args.texture_format,
-        merge: MergeSettings {
+    let splat = super::splat_settings(
+        args.tile_size,
+        args.texture_format,
+        MergeSettings {
             levels: args.merge_levels,
+            min_radius_px: args.merge_min_radius,
+            color_tolerance: args.merge_color_tolerance,
             ..MergeSettings::default()
         },
-        ..SplatSettings::default()
-    };
-    splat
-        .validate()
-        .map_err(|e| Error::input(format!("--tile-size / --merge-levels: {e}")))?;
+    )?;
     if args.slices == 0 {
         return Err(Error::input("--slices must be at least 1"));
     }

@@ -83,6 +83,24 @@ pub fn run(cli: Cli) -> Result<()> {
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
 /// reader never sees a partial file and a failed run leaves no file behind.
+/// Splat settings from the command line, validated (errors name the options).
+pub(crate) fn splat_settings(
+    tile_size: u32,
+    texture_format: crate::render::splat::PsfTextureFormat,
+    merge: crate::render::splat::MergeSettings,
+) -> Result<crate::render::splat::SplatSettings> {
+    let settings = crate::render::splat::SplatSettings {
+        tile_size,
+        texture_format,
+        merge,
+        ..crate::render::splat::SplatSettings::default()
+    };
+    settings
+        .validate()
+        .map_err(|e| crate::Error::input(format!("--tile-size / --merge-*: {e}")))?;
+    Ok(settings)
+}
+
 /// Kernel options honouring `--cache DIR` and `--no-cache`.
 pub(crate) fn kernel_options(
     cache: Option<&std::path::PathBuf>,

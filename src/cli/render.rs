@@ -16,7 +16,7 @@ use crate::psf::cache::CacheOutcome;
 use crate::render::frame::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, Method,
 };
-use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat, SplatSettings};
+use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
 use crate::render::Rasterizer;
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -341,18 +341,14 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             args.output.display()
         )));
     }
-    let splat = SplatSettings {
-        tile_size: args.tile_size,
-        texture_format: args.texture_format,
-        merge: MergeSettings {
+    let splat = super::splat_settings(
+        args.tile_size,
+        args.texture_format,
+        MergeSettings {
             levels: args.merge_levels,
             ..MergeSettings::default()
         },
-        ..SplatSettings::default()
-    };
-    splat
-        .validate()
-        .map_err(|e| Error::input(format!("--tile-size / --merge-levels: {e}")))?;
+    )?;
     let eye = load_eye(&args.eye)?;
     let ctx = Context::new(&cli.context_options())?;
     let input = load_input(cli, args, &ctx)?;
