@@ -53,6 +53,7 @@ fn four_preset_eyes_match_the_ground_truth() {
         height: H,
         color: &color,
         depth_m: &depth,
+        fov_y_deg: 20.0,
     };
     let state = EyeState {
         focus_d: 1.0 / 7.5,
@@ -69,7 +70,7 @@ fn four_preset_eyes_match_the_ground_truth() {
     };
     for name in ["healthy", "myopia", "astigmatism", "keratoconus"] {
         let eye = resolve(name).unwrap().eye;
-        let needs = scene_needs(&[dioptre_range(&depth)], &[state], screen);
+        let needs = scene_needs(&[dioptre_range(&depth, W, H, 20.0)], &[state], screen);
         let kernels = prepare_kernels(&eye, &needs, &options).unwrap();
         let max_radius = kernels.grid.max_radius_px;
         let mut renderer = FrameRenderer::new(

@@ -104,6 +104,7 @@ fn real_kernels_splat_like_the_ground_truth() {
         height: h,
         color: &color,
         depth_m: &depth,
+        fov_y_deg: 3.0,
     };
     let truth = reference::render(&input, &exact);
     let ctx = common::gpu();

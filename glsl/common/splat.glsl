@@ -11,7 +11,7 @@ struct Fragment {
     float index;   // continuous index on the object-dioptre axis of the PSF texture
     vec2 center;   // footprint centre in pixels (a pixel's centre is x + 0.5)
     uint size;     // 1 = single pixel, 2 or 4 = merged block; 0 = merged away
-    uint pad;
+    float dioptre; // vergence along the pixel's ray (D, unclamped): the blend's grouping key
 };
 
 // Per-frame constants, identical for every pass. Mirrors `FrameParams` in mod.rs.
@@ -32,15 +32,52 @@ layout(push_constant) uniform FrameParams {
     uint band_first_tile;  // tiles [band_first_tile, band_end_tile) are processed this band
     uint band_end_tile;
     uint band_first_entry; // global list offset of the band's first entry
+    float focal_px;        // (H/2)/tan(fov_y/2)
+    float group_tolerance_d;
+    uint blend_mode;       // 0 = depth groups, 1 = the seed paper's per-fragment blend
+    uint wide_field;       // 1 = vergence along rays and kernels at the local pinhole scale
     uvec4 pass_u;          // pass-specific values (see each pass)
     vec4 pass_f;
 } frame;
 
+// The kernel layout at a screen point (see src/render/projection.rs): xy = radial unit
+// vector, z = cos θ. A screen offset d maps to the kernel offset
+// cos θ·d + (cos²θ − cos θ)(d·e)e, and weights scale by cos³θ.
+vec3 local_scale(vec2 center) {
+    if (frame.wide_field == 0u) {
+        return vec3(1.0, 0.0, 1.0);
+    }
+    vec2 u = center - 0.5 * vec2(frame.width, frame.height);
+    float rho = length(u);
+    if (rho < 1e-6) {
+        return vec3(1.0, 0.0, 1.0);
+    }
+    return vec3(u / rho, frame.focal_px / sqrt(frame.focal_px * frame.focal_px + rho * rho));
+}
+
+// Radial and tangential shrink for a kernel of radius r: (cos²θ, cos θ) from 1.5 px up,
+// none below 0.5 px (an in-focus kernel keeps its pixel), linear between.
+vec2 shrink_for_radius(float cos_theta, float r) {
+    float t = clamp(r - 0.5, 0.0, 1.0);
+    return vec2(1.0) + t * (vec2(cos_theta * cos_theta, cos_theta) - vec2(1.0));
+}
+
+// Kernel offset of screen offset d; e = radial unit vector, c = (radial, tangential) shrink.
+vec2 kernel_offset(vec2 e, vec2 c, vec2 d) {
+    return c.y * d + (c.x - c.y) * dot(d, e) * e;
+}
+
 // How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.
 // Kernels of radius r occupy (2r+1)² texels centred on the fragment; a merged fragment sits
-// half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further.
+// half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further. Off
+// the centre of a wide frame a kernel stretches by up to 1/cos²θ and is read bilinearly
+// between texels, so it reaches up to (r + 1)/cos²θ, exclusive.
 float fragment_reach(Fragment f) {
     float r = ceil(max(f.radius.r, max(f.radius.g, f.radius.b)));
+    float c = local_scale(f.center).z;
+    if (c < 1.0) {
+        r = ceil((r + 1.0) / (c * c)) - 1.0;
+    }
     return f.size > 1u ? r + 0.5 : r;
 }
 

@@ -154,7 +154,16 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let kernels = prepare_kernels(
         &eye,
-        &scene_needs(&[dioptre_range(&frame.depth_m)], &[eye_state], screen),
+        &scene_needs(
+            &[dioptre_range(
+                &frame.depth_m,
+                width,
+                height,
+                screen.fov_y_deg,
+            )],
+            &[eye_state],
+            screen,
+        ),
         &options,
     )?;
     let precompute = Precompute {
@@ -172,6 +181,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         height,
         color: &frame.color,
         depth_m: &frame.depth_m,
+        fov_y_deg: screen.fov_y_deg,
     };
 
     let bar = frame_bar((args.warmup + args.frames) as u64);

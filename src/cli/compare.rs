@@ -148,7 +148,16 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     options.settings.sample_um = args.sample_um;
     let kernels = prepare_kernels(
         &eye,
-        &scene_needs(&[dioptre_range(&frame.depth_m)], &[eye_state], screen),
+        &scene_needs(
+            &[dioptre_range(
+                &frame.depth_m,
+                width,
+                height,
+                screen.fov_y_deg,
+            )],
+            &[eye_state],
+            screen,
+        ),
         &options,
     )?;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
@@ -158,6 +167,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         height,
         color: &frame.color,
         depth_m: &frame.depth_m,
+        fov_y_deg: screen.fov_y_deg,
     };
 
     let truth = match &args.truth_in {

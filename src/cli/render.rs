@@ -242,7 +242,14 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
         }
         return Ok(d);
     }
-    let depth_at = |x: u32, y: u32| input.depth_m[(y * input.width + x) as usize];
+    let projection = crate::render::projection::Projection {
+        width: input.width,
+        height: input.height,
+        fov_y_deg: input.fov_y_deg,
+    };
+    // Vergence along the pixel's ray, as every method uses it.
+    let dioptre_at =
+        |x: u32, y: u32| projection.dioptre_at(x, y, input.depth_m[(y * input.width + x) as usize]);
     if let Some((x, y)) = args.focus_at {
         if x >= input.width || y >= input.height {
             return Err(Error::input(format!(
@@ -250,7 +257,7 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
                 input.width, input.height
             )));
         }
-        return Ok(crate::render::reference::dioptre_of_depth(depth_at(x, y)));
+        return Ok(dioptre_at(x, y));
     }
     if let Some(m) = input.focus_m {
         return Ok(if m.is_finite() && m > 0.0 {
@@ -259,10 +266,7 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
             0.0
         });
     }
-    Ok(crate::render::reference::dioptre_of_depth(depth_at(
-        input.width / 2,
-        input.height / 2,
-    )))
+    Ok(dioptre_at(input.width / 2, input.height / 2))
 }
 
 /// Mean luminance (cd/m²) of linear Rec.709 RGB.
@@ -366,7 +370,16 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         fov_y_deg: input.fov_y_deg,
         height_px: input.height,
     };
-    let needs = scene_needs(&[dioptre_range(&input.depth_m)], &[state], screen);
+    let needs = scene_needs(
+        &[dioptre_range(
+            &input.depth_m,
+            input.width,
+            input.height,
+            input.fov_y_deg,
+        )],
+        &[state],
+        screen,
+    );
     let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let kernels = prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
@@ -379,6 +392,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         height: input.height,
         color: &input.color,
         depth_m: &input.depth_m,
+        fov_y_deg: input.fov_y_deg,
     };
     let frame = renderer.render(&frame_input, state, args.method)?;
 

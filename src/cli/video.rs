@@ -301,7 +301,12 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
                 frame.color.clone(),
             )));
         }
-        ranges.push(dioptre_range(&frame.depth_m));
+        ranges.push(dioptre_range(
+            &frame.depth_m,
+            width,
+            height,
+            state.camera.fov_y_deg,
+        ));
         states.push(EyeState {
             focus_d: timeline.focus_d(i, &state),
             pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
@@ -339,6 +344,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             height,
             color: &frame.color,
             depth_m: &frame.depth_m,
+            fov_y_deg: state.camera.fov_y_deg,
         };
         let mut panels = Vec::new();
         for renderer in renderers.iter_mut() {

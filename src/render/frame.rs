@@ -13,7 +13,6 @@ use crate::psf::exact::ExactEye;
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::KernelGrid;
 use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
-use crate::render::reference::dioptre_of_depth;
 use crate::render::splat::{FrameInput, SplatSettings, SplatStats, Splatter, ViewState};
 use crate::render::{reference, slices};
 use crate::{Error, Result};
@@ -80,11 +79,16 @@ pub struct PreparedKernels {
     pub seconds: f64,
 }
 
-/// Smallest and largest object vergence of a depth buffer (infinity = 0 D).
-pub fn dioptre_range(depth_m: &[f32]) -> (f64, f64) {
+/// Smallest and largest object vergence (along each pixel's ray; infinity = 0 D) of a
+/// `width`×`height` view-axis depth buffer seen with a vertical field of `fov_y_deg`.
+pub fn dioptre_range(depth_m: &[f32], width: u32, height: u32, fov_y_deg: f64) -> (f64, f64) {
+    let projection = crate::render::projection::Projection {
+        width,
+        height,
+        fov_y_deg,
+    };
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    for &d in depth_m {
-        let v = dioptre_of_depth(d);
+    for v in projection.dioptres(depth_m) {
         lo = lo.min(v);
         hi = hi.max(v);
     }

@@ -1,7 +1,9 @@
 //! Rendering: joins scenes, the eye's kernels (`psf`) and the GPU layer (`gpu`). Each GPU pass
 //! is one Rust file plus GLSL files of the same stem under glsl/render/.
 
+pub mod blend;
 pub mod frame;
+pub mod projection;
 pub mod raster;
 pub mod reference;
 pub mod slices;

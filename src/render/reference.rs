@@ -1,13 +1,17 @@
-//! Ground truth: every pixel splats the exact kernel of its own dioptre (rounded to bins of
-//! 0.001 D) for each channel — no interpolation over distance or radius, no merging — with the
-//! same front-to-back blending as the splat runtime. It is the oracle of the tests and of the
-//! quality figures, so it is written independently of the GPU passes (CPU, rayon, per tile).
+//! Ground truth for the kernel approximations: every pixel splats the exact kernel of its own
+//! vergence (along its ray, rounded to bins of 0.001 D) for each channel, laid out with the
+//! pinhole's local scale — no interpolation over distance or radius, no merging — with the
+//! blend of [`super::blend`] (which it shares with the splat runtime: it judges the kernel
+//! pipeline, not the blend; the blend is judged against plain convolutions in the tests). It is
+//! written independently of the GPU passes (CPU, rayon, per tile).
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use rayon::prelude::*;
 
+use super::blend::{BlendSettings, PixelBlend};
+use super::projection::LocalScale;
 use super::splat::FrameInput;
 
 /// Bin width of the ground truth's dioptre quantisation (the seed paper's 3 decimals).
@@ -34,6 +38,16 @@ impl Kernel {
         }
         self.values[((dy + r) * (2 * r + 1) + dx + r) as usize]
     }
+
+    /// Bilinear interpolation between texels at a fractional offset (zero outside), as a
+    /// texture with linear filtering and a zero border samples it.
+    pub fn sample(&self, dx: f64, dy: f64) -> f32 {
+        let (x0, y0) = (dx.floor(), dy.floor());
+        let (tx, ty) = ((dx - x0) as f32, (dy - y0) as f32);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        (1.0 - ty) * ((1.0 - tx) * self.at(x0, y0) + tx * self.at(x0 + 1, y0))
+            + ty * ((1.0 - tx) * self.at(x0, y0 + 1) + tx * self.at(x0 + 1, y0 + 1))
+    }
 }
 
 /// The exact kernel for a channel (0 = R, 1 = G, 2 = B) at an object vergence in dioptres, for
@@ -51,54 +65,74 @@ pub fn dioptre_of_depth(depth_m: f32) -> f64 {
     }
 }
 
-/// The sort key the runtime uses: depth bits (infinity as a huge finite depth), then index.
-pub fn sort_depth(depth_m: f32) -> f32 {
-    if depth_m > 0.0 && !depth_m.is_nan() {
-        if depth_m.is_finite() {
-            depth_m
-        } else {
-            3.0e38
-        }
-    } else {
-        3.0e38
-    }
-}
-
 fn bin_of(dioptre: f64) -> i64 {
     (dioptre / DIOPTRE_BIN_D).round() as i64
 }
 
-/// Renders the ground truth. `tile` only sets the work granularity (results do not depend on
-/// it). Returns linear RGBA (alpha 1), row-major.
+/// Renders the ground truth with the default blend (depth groups, wide-field geometry).
+/// Returns linear RGBA (alpha 1), row-major.
 pub fn render(input: &FrameInput<'_>, kernels: &dyn ExactKernels) -> Vec<[f32; 4]> {
+    render_with(input, kernels, &BlendSettings::default())
+}
+
+/// Renders the ground truth with the given blend and geometry.
+pub fn render_with(
+    input: &FrameInput<'_>,
+    kernels: &dyn ExactKernels,
+    blend: &BlendSettings,
+) -> Vec<[f32; 4]> {
     let (w, h) = (input.width as usize, input.height as usize);
-    let bins: Vec<i64> = input
-        .depth_m
-        .iter()
-        .map(|&d| bin_of(dioptre_of_depth(d)))
-        .collect();
+    let projection = input.projection();
+    let wide = blend.wide_field;
+    let dioptres: Vec<f64> = if wide {
+        projection.dioptres(input.depth_m)
+    } else {
+        input.depth_m.iter().map(|&d| dioptre_of_depth(d)).collect()
+    };
+    let bins: Vec<i64> = dioptres.iter().map(|&d| bin_of(d)).collect();
     let kernel_table = exact_kernels_for(&bins, kernels);
     let lookup = |channel: usize, bin: i64| -> &Kernel { &kernel_table[&(channel, bin)] };
+    let scales: Vec<LocalScale> = (0..w * h)
+        .map(|i| {
+            if wide {
+                projection.local_scale((i % w) as f64 + 0.5, (i / w) as f64 + 0.5)
+            } else {
+                LocalScale::CENTRE
+            }
+        })
+        .collect();
 
-    // Reach of each pixel's fragment: the largest kernel radius over its channels.
+    // Reach of each pixel's fragment in screen pixels: the largest kernel radius over its
+    // channels, stretched by the local scale (bilinear lookups reach one texel further).
     let reach: Vec<i64> = bins
         .iter()
-        .map(|&b| {
-            (0..3)
-                .map(|c| lookup(c, b).radius as i64)
-                .max()
-                .unwrap_or(0)
+        .zip(&scales)
+        .map(|(&b, s)| {
+            let r = (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0) as f64;
+            if s.cos_theta < 1.0 {
+                ((r + 1.0) * s.max_stretch()).ceil() as i64 - 1
+            } else {
+                r as i64
+            }
         })
         .collect();
     let max_reach = reach.iter().copied().max().unwrap_or(0);
+    // The largest kernel radius over the channels sets how much of the local scale applies.
+    let natural: Vec<f64> = bins
+        .iter()
+        .map(|&b| (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0) as f64)
+        .collect();
     const TILE: usize = 16;
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
-    let keys: Vec<(u32, u32)> = input
-        .depth_m
+    // Front to back along each pixel's ray (ties by index, deterministic).
+    let keys: Vec<(u32, u32)> = dioptres
         .iter()
         .enumerate()
-        .map(|(i, &d)| (sort_depth(d).to_bits(), i as u32))
+        .map(|(i, &d)| {
+            let distance = if d > 0.0 { (1.0 / d) as f32 } else { 3.0e38 };
+            (distance.to_bits(), i as u32)
+        })
         .collect();
 
     let tiles: Vec<Vec<(usize, [f32; 4])>> = (0..tiles_x * tiles_y)
@@ -127,21 +161,28 @@ pub fn render(input: &FrameInput<'_>, kernels: &dyn ExactKernels) -> Vec<[f32; 4
             let mut out = Vec::with_capacity(TILE * TILE);
             for py in y0..=y1 {
                 for px in x0..=x1 {
-                    let mut c = [0.0f32; 3];
-                    let mut a = [0.0f32; 3];
+                    let mut pixel = [PixelBlend::default(); 3];
                     for &i in &list {
                         let i = i as usize;
                         let (fx, fy) = ((i % w) as i64, (i / w) as i64);
                         if (px - fx).abs() > reach[i] || (py - fy).abs() > reach[i] {
                             continue;
                         }
-                        for ch in 0..3 {
-                            let weight = lookup(ch, bins[i]).at(px - fx, py - fy);
-                            c[ch] += (1.0 - a[ch]) * weight * input.color[i][ch];
-                            a[ch] += (1.0 - a[ch]) * weight;
+                        let s = &scales[i];
+                        let d = [(px - fx) as f64, (py - fy) as f64];
+                        let r = natural[i];
+                        for (ch, p) in pixel.iter_mut().enumerate() {
+                            let k = lookup(ch, bins[i]);
+                            let weight = if s.cos_theta < 1.0 && r > 0.5 {
+                                let [kx, ky] = s.kernel_offset(d, r);
+                                k.sample(kx, ky) * s.area_factor(r) as f32
+                            } else {
+                                k.at(d[0] as i64, d[1] as i64)
+                            };
+                            p.add(blend, dioptres[i] as f32, weight, input.color[i][ch]);
                         }
                     }
-                    let value = [0, 1, 2].map(|ch| if a[ch] > 0.0 { c[ch] / a[ch] } else { 0.0 });
+                    let value = pixel.map(PixelBlend::resolve);
                     out.push((
                         py as usize * w + px as usize,
                         [value[0], value[1], value[2], 1.0],
@@ -180,11 +221,13 @@ fn exact_kernels_for(
         .collect()
 }
 
-/// Number of distinct dioptre bins in a depth buffer (what the ground truth must compute).
-pub fn distinct_bins(depth_m: &[f32]) -> usize {
-    let mut bins: Vec<i64> = depth_m
+/// Number of distinct dioptre bins of a frame (what the ground truth must compute).
+pub fn distinct_bins(input: &FrameInput<'_>) -> usize {
+    let mut bins: Vec<i64> = input
+        .projection()
+        .dioptres(input.depth_m)
         .iter()
-        .map(|&d| bin_of(dioptre_of_depth(d)))
+        .map(|&d| bin_of(d))
         .collect();
     bins.sort_unstable();
     bins.dedup();

@@ -6,7 +6,7 @@
 
 use rayon::prelude::*;
 
-use super::reference::{dioptre_of_depth, ExactKernels, Kernel};
+use super::reference::{ExactKernels, Kernel};
 use super::splat::FrameInput;
 
 /// The seed paper's slice count.
@@ -16,7 +16,9 @@ pub const DEFAULT_SLICES: usize = 41;
 pub fn render(input: &FrameInput<'_>, kernels: &dyn ExactKernels, slices: usize) -> Vec<[f32; 4]> {
     let (w, h) = (input.width as usize, input.height as usize);
     let slices = slices.max(1);
-    let dioptres: Vec<f64> = input.depth_m.iter().map(|&d| dioptre_of_depth(d)).collect();
+    // Vergence along each pixel's ray (slices share one kernel each, so the local scale of a
+    // wide frame does not apply to them).
+    let dioptres: Vec<f64> = input.projection().dioptres(input.depth_m);
     let lo = dioptres.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = dioptres.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let width_d = ((hi - lo) / slices as f64).max(1e-9);

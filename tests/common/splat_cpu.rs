@@ -11,6 +11,35 @@ pub struct Frame {
     pub dioptre_min: f32,
     pub dioptre_step: f32,
     pub max_radius: u32,
+    /// Focal length in pixels for the wide-field geometry; 0 = the centre's scale everywhere
+    /// and view-axis vergence.
+    pub focal_px: f32,
+}
+
+impl Frame {
+    /// Distance along the ray over view-axis depth at a screen point.
+    pub fn ray_factor(&self, x: f32, y: f32) -> f32 {
+        if self.focal_px <= 0.0 {
+            return 1.0;
+        }
+        let u = (x - 0.5 * self.width as f32) / self.focal_px;
+        let v = (y - 0.5 * self.height as f32) / self.focal_px;
+        (1.0 + u * u + v * v).sqrt()
+    }
+
+    /// cos θ of the direction through a screen point (1 without the wide-field geometry).
+    pub fn cos_theta(&self, x: f32, y: f32) -> f32 {
+        if self.focal_px <= 0.0 {
+            return 1.0;
+        }
+        let u = x - 0.5 * self.width as f32;
+        let v = y - 0.5 * self.height as f32;
+        let rho = (u * u + v * v).sqrt();
+        if rho < 1e-6 {
+            return 1.0;
+        }
+        self.focal_px / (self.focal_px * self.focal_px + rho * rho).sqrt()
+    }
 }
 
 pub fn fragments(
@@ -23,11 +52,14 @@ pub fn fragments(
     (0..frame.width * frame.height)
         .map(|i| {
             let d = depth[i as usize];
-            let dioptre = if d > 0.0 && d.is_finite() {
-                1.0 / d
-            } else {
-                0.0
-            };
+            let finite = d > 0.0 && d.is_finite();
+            let center = [
+                (i % frame.width) as f32 + 0.5,
+                (i / frame.width) as f32 + 0.5,
+            ];
+            // Light arrives with the vergence of the distance along the pixel's ray.
+            let distance = d * frame.ray_factor(center[0], center[1]);
+            let dioptre = if finite { 1.0 / distance } else { 0.0 };
             let index = ((dioptre - frame.dioptre_min) / frame.dioptre_step).clamp(0.0, last);
             let i0 = index.floor() as usize;
             let i1 = (i0 + 1).min(radii.len() - 1);
@@ -38,15 +70,12 @@ pub fn fragments(
             let c = color[i as usize];
             Fragment {
                 color: [c[0], c[1], c[2]],
-                depth: if d > 0.0 { d } else { 3.0e38 },
+                depth: if finite { distance } else { 3.0e38 },
                 radius,
                 index,
-                center: [
-                    (i % frame.width) as f32 + 0.5,
-                    (i / frame.width) as f32 + 0.5,
-                ],
+                center,
                 size: 1,
-                pad: 0,
+                dioptre,
             }
         })
         .collect()
@@ -91,6 +120,7 @@ pub fn merge_level(frame: &Frame, fragments: &mut [Fragment], settings: &MergeSe
             m.color = [0, 1, 2].map(|c| 0.25 * f.iter().map(|x| x.color[c]).sum::<f32>());
             m.depth = f.iter().map(|x| x.depth).fold(f32::INFINITY, f32::min);
             m.index = 0.25 * f.iter().map(|x| x.index).sum::<f32>();
+            m.dioptre = 0.25 * f.iter().map(|x| x.dioptre).sum::<f32>();
             // Second-moment match of the s×s block: R'² = R² + (s² − c²)/3.
             let grow = (size * size - child * child) as f32 / 3.0;
             m.radius = [0, 1, 2].map(|c| {
@@ -112,7 +142,12 @@ pub fn merge_level(frame: &Frame, fragments: &mut [Fragment], settings: &MergeSe
 
 /// Inclusive pixel rectangle a fragment's kernel can reach (square support).
 pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
-    let r = f.radius.iter().fold(0.0f32, |a, &b| a.max(b)).ceil();
+    let mut r = f.radius.iter().fold(0.0f32, |a, &b| a.max(b)).ceil();
+    // Off the centre of a wide frame a kernel stretches by up to 1/cos²θ, read bilinearly.
+    let c = frame.cos_theta(f.center[0], f.center[1]);
+    if c < 1.0 {
+        r = ((r + 1.0) / (c * c)).ceil() - 1.0;
+    }
     let reach = if f.size > 1 { r + 0.5 } else { r };
     let x0 = ((f.center[0] - 0.5 - reach).ceil() as i64).max(0);
     let y0 = ((f.center[1] - 0.5 - reach).ceil() as i64).max(0);

@@ -1,9 +1,13 @@
 #version 460
 // Convolution: one workgroup per tile walks the tile's sorted list front to back, streaming
 // fragments through shared memory in batches, and blends each fragment's kernel into every
-// pixel of the tile: per channel, C += (1 − A)·w·c and A += (1 − A)·w; the output is C / A.
-// The kernel weight w comes from two trilinear lookups in the PSF texture (floor and ceiling
-// radius; the layer axis blends the two neighbouring object distances), mixed by frac(radius).
+// pixel of the tile (src/render/blend.rs): per pixel and channel, consecutive fragments whose
+// vergences differ by at most the group tolerance form a group that adds linearly
+// (Cg += w·c, Ag += w); groups composite front to back, C += (1 − A)·Cg/max(Ag, 1),
+// A += (1 − A)·min(Ag, 1); the output is C / A. (blend_mode 1: the seed paper's per-fragment
+// C += (1 − A)·w·c, A += (1 − A)·w.) The kernel weight w comes from two trilinear lookups in
+// the PSF texture (floor and ceiling radius; the layer axis blends the two neighbouring object
+// distances), mixed by frac(radius), at the kernel offset of the local pinhole scale.
 #extension GL_GOOGLE_include_directive : require
 #include "splat.glsl"
 
@@ -23,7 +27,8 @@ const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
 // reads 16 bytes instead of the whole 48-byte fragment.
-shared vec4 batch_reach[64];   // centre.xy, reach, unused
+shared vec4 batch_reach[64];   // centre.xy, reach, 1 when the local scale applies
+shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shrink
 shared Fragment batch[64];
 
 // RGB kernel values at integer radius r (divided by the (2r+1)² storage scale).
@@ -61,8 +66,10 @@ vec3 fragment_weight(Fragment f, vec2 d) {
         }
     }
     if (f.size > 1u) {
-        // A merged block covers size² pixels' worth of the same light.
-        w = vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(float(f.size * f.size)));
+        // A merged block carries size² pixels' worth of the same light.
+        float n = float(f.size * f.size);
+        w = frame.blend_mode == 0u ? n * w
+                                   : vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(n));
     }
     return w;
 }
@@ -81,18 +88,30 @@ void main() {
     vec2 centre[PIXELS];
     vec3 C[PIXELS];
     vec3 A[PIXELS];
+    vec3 Cg[PIXELS];     // the open group's light and coverage
+    vec3 Ag[PIXELS];
+    float last[PIXELS];  // vergence of the last fragment that reached the pixel (−1: none)
     for (uint q = 0u; q < PIXELS; q++) {
         uvec2 pixel = uvec2(tx, ty) * TILE + gl_LocalInvocationID.xy + 8u * uvec2(q % PER_AXIS, q / PER_AXIS);
         centre[q] = vec2(pixel) + 0.5;
         C[q] = vec3(0.0);
         A[q] = vec3(0.0);
+        Cg[q] = vec3(0.0);
+        Ag[q] = vec3(0.0);
+        last[q] = -1.0;
     }
+    bool grouped = frame.blend_mode == 0u;
 
     for (uint start = 0u; start < n; start += 64u) {
         if (start + local_index < n) {
             Fragment f = fragments[entries[base + start + local_index].y];
             batch[local_index] = f;
-            batch_reach[local_index] = vec4(f.center, fragment_reach(f), 0.0);
+            vec3 s = local_scale(f.center);
+            // The largest channel radius decides how much of the local scale applies.
+            float r = max(f.radius.r, max(f.radius.g, f.radius.b));
+            vec2 c = shrink_for_radius(s.z, r);
+            batch_reach[local_index] = vec4(f.center, fragment_reach(f), c.x < 1.0 ? 1.0 : 0.0);
+            batch_scale[local_index] = vec4(s.xy, c);
         }
         barrier();
         uint batch_size = min(64u, n - start);
@@ -104,15 +123,37 @@ void main() {
                     continue;
                 }
                 Fragment f = batch[j];
-                vec3 w = fragment_weight(f, d);
-                C[q] += (vec3(1.0) - A[q]) * w * f.color;
-                A[q] += (vec3(1.0) - A[q]) * w;
+                vec3 w;
+                if (g.w > 0.5) {
+                    vec4 s = batch_scale[j];
+                    w = fragment_weight(f, kernel_offset(s.xy, s.zw, d)) * (s.z * s.w);
+                } else {
+                    w = fragment_weight(f, d);
+                }
+                if (grouped) {
+                    if (last[q] >= 0.0 && abs(f.dioptre - last[q]) > frame.group_tolerance_d) {
+                        vec3 scale = vec3(1.0) / max(Ag[q], vec3(1.0));
+                        C[q] += (vec3(1.0) - A[q]) * Cg[q] * scale;
+                        A[q] += (vec3(1.0) - A[q]) * Ag[q] * scale;
+                        Cg[q] = vec3(0.0);
+                        Ag[q] = vec3(0.0);
+                    }
+                    Cg[q] += w * f.color;
+                    Ag[q] += w;
+                    last[q] = f.dioptre;
+                } else {
+                    C[q] += (vec3(1.0) - A[q]) * w * f.color;
+                    A[q] += (vec3(1.0) - A[q]) * w;
+                }
             }
         }
         barrier();
     }
 
     for (uint q = 0u; q < PIXELS; q++) {
+        vec3 scale = vec3(1.0) / max(Ag[q], vec3(1.0));
+        C[q] += (vec3(1.0) - A[q]) * Cg[q] * scale;
+        A[q] += (vec3(1.0) - A[q]) * Ag[q] * scale;
         uvec2 pixel = uvec2(centre[q]);
         if (pixel.x < frame.width && pixel.y < frame.height) {
             vec3 a = A[q];

@@ -1,5 +1,5 @@
 #version 460
-// One fragment per pixel: colour, depth, continuous index on the object-dioptre axis and the
+// One fragment per pixel: colour, distance along the ray, continuous index on the object-dioptre axis and the
 // blur radius per channel, interpolated between the two neighbouring object distances.
 #extension GL_GOOGLE_include_directive : require
 #include "splat.glsl"
@@ -19,8 +19,13 @@ void main() {
     }
     vec3 color = imageLoad(color_in, ivec2(p)).rgb;
     float depth = imageLoad(depth_in, ivec2(p)).r;
-    // Infinite, missing or non-positive depth is optical infinity (0 D).
-    float dioptre = (depth > 0.0 && !isinf(depth) && !isnan(depth)) ? 1.0 / depth : 0.0;
+    // Infinite, missing or non-positive depth is optical infinity (0 D). Depth is along the
+    // view axis; light reaches the eye with the vergence of the distance along the ray.
+    bool finite_depth = depth > 0.0 && !isinf(depth) && !isnan(depth);
+    vec2 u = (vec2(p) + 0.5 - 0.5 * vec2(frame.width, frame.height)) / frame.focal_px;
+    float ray = frame.wide_field != 0u ? sqrt(1.0 + dot(u, u)) : 1.0;
+    float distance = depth * ray;
+    float dioptre = finite_depth ? 1.0 / distance : 0.0;
     float last = float(frame.object_count - 1u);
     float index = clamp((dioptre - frame.dioptre_min) / frame.dioptre_step, 0.0, last);
     uint i0 = uint(floor(index));
@@ -29,11 +34,11 @@ void main() {
 
     Fragment f;
     f.color = color;
-    f.depth = (depth > 0.0 && !isnan(depth)) ? depth : 3.0e38;
+    f.depth = finite_depth ? distance : 3.0e38;
     f.radius = min(radius, vec3(float(frame.max_radius)));
     f.index = index;
     f.center = vec2(p) + 0.5;
     f.size = 1u;
-    f.pad = 0u;
+    f.dioptre = dioptre;
     fragments[p.y * frame.width + p.x] = f;
 }

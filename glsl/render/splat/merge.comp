@@ -67,7 +67,7 @@ void main() {
     m.radius = min(sqrt(r_max * r_max + grow), vec3(float(frame.max_radius)));
     m.center = vec2(origin) + 0.5 * float(size);
     m.size = size;
-    m.pad = 0u;
+    m.dioptre = 0.25 * (f[0].dioptre + f[1].dioptre + f[2].dioptre + f[3].dioptre);
     fragments[ids[0]] = m;
     for (int k = 1; k < 4; k++) {
         fragments[ids[k]].size = 0u;

@@ -21,6 +21,7 @@ use crate::gpu::{
     Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings,
 };
 use crate::psf::kernels::KernelGrid;
+use crate::render::blend::{BlendMode, BlendSettings};
 
 pub use psf_texture::PsfTextureFormat;
 
@@ -34,10 +35,11 @@ pub struct Fragment {
     pub index: f32,
     pub center: [f32; 2],
     pub size: u32,
-    pub pad: u32,
+    /// Vergence along the pixel's ray (D, unclamped): the blend's grouping key.
+    pub dioptre: f32,
 }
 
-/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (96 bytes).
+/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (112 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct FrameParams {
@@ -57,6 +59,10 @@ pub(crate) struct FrameParams {
     pub band_first_tile: u32,
     pub band_end_tile: u32,
     pub band_first_entry: u32,
+    pub focal_px: f32,
+    pub group_tolerance_d: f32,
+    pub blend_mode: u32,
+    pub wide_field: u32,
     pub pass_u: [u32; 4],
     pub pass_f: [f32; 4],
 }
@@ -95,6 +101,8 @@ pub struct SplatSettings {
     /// Upper bound on the tile-list buffer (bytes); bands are used beyond it. The device's
     /// storage-buffer binding limit applies as well.
     pub max_list_bytes: u64,
+    /// How fragments combine, and the wide-field geometry.
+    pub blend: BlendSettings,
 }
 
 impl Default for SplatSettings {
@@ -104,6 +112,7 @@ impl Default for SplatSettings {
             texture_format: PsfTextureFormat::Rgba16Float,
             merge: MergeSettings::default(),
             max_list_bytes: 1 << 30,
+            blend: BlendSettings::default(),
         }
     }
 }
@@ -128,7 +137,7 @@ impl SplatSettings {
         {
             return Err("merge thresholds must be non-negative numbers".into());
         }
-        Ok(())
+        self.blend.validate()
     }
 }
 
@@ -141,6 +150,18 @@ pub struct FrameInput<'a> {
     pub color: &'a [[f32; 4]],
     /// Distance along the view axis in metres; 0, negative or infinite = optical infinity.
     pub depth_m: &'a [f32],
+    /// Vertical field of view of the pinhole camera that made the frame (degrees).
+    pub fov_y_deg: f64,
+}
+
+impl FrameInput<'_> {
+    pub fn projection(&self) -> crate::render::projection::Projection {
+        crate::render::projection::Projection {
+            width: self.width,
+            height: self.height,
+            fov_y_deg: self.fov_y_deg,
+        }
+    }
 }
 
 /// The eye's state for one frame.
@@ -363,6 +384,13 @@ impl Splatter {
             band_first_tile: 0,
             band_end_tile: frame.tiles_x * frame.tiles_y,
             band_first_entry: 0,
+            focal_px: 1.0,
+            group_tolerance_d: self.settings.blend.group_tolerance_d,
+            blend_mode: match self.settings.blend.mode {
+                BlendMode::Grouped => 0,
+                BlendMode::PerFragment => 1,
+            },
+            wide_field: u32::from(self.settings.blend.wide_field),
             pass_u: [0; 4],
             pass_f: [0.0; 4],
         }
@@ -384,6 +412,12 @@ impl Splatter {
                 input.depth_m.len()
             )));
         }
+        if !(input.fov_y_deg.is_finite() && input.fov_y_deg > 0.1 && input.fov_y_deg < 170.0) {
+            return Err(crate::Error::input(format!(
+                "vertical field of view {} degrees is outside 0.1 to 170",
+                input.fov_y_deg
+            )));
+        }
         if !(view.pupil_mm.is_finite() && view.pupil_mm > 0.0 && view.focus_d.is_finite()) {
             return Err(crate::Error::input(format!(
                 "pupil {} mm / focus {} D must be finite, pupil positive",
@@ -402,7 +436,8 @@ impl Splatter {
             .iter()
             .map(|r| [r[0], r[1], r[2], 0.0])
             .collect();
-        let params = self.params(frame);
+        let mut params = self.params(frame);
+        params.focal_px = input.projection().focal_px() as f32;
         let tiles = frame.tiles_x * frame.tiles_y;
 
         // Submission 1: everything up to the exact list size.
