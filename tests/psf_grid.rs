@@ -9,7 +9,7 @@ use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
 use ocular::psf::defocus::{ChannelOptics, ColumnOptics};
 use ocular::psf::exact::ExactEye;
 use ocular::psf::grid::{compute_grid, no_progress};
-use ocular::psf::kernels::{kernel_side, DioptreAxis};
+use ocular::psf::kernels::{kernel_side, level_block_radius, level_count, DioptreAxis};
 use ocular::psf::plan::{plan_for_scene, SceneNeeds};
 use ocular::psf::project::{cropped_psf, cropped_psf_at_f, CroppedPsf};
 use ocular::render::reference::ExactKernels;
@@ -97,9 +97,10 @@ fn kernels_sum_to_one_and_crops_keep_the_energy() {
     assert!(report.min_kept_energy >= settings.energy, "{report:?}");
     let set = &grid.sets[0];
     assert!(grid.max_radius_px >= 3, "Rmax {}", grid.max_radius_px);
-    for r in 0..=grid.max_radius_px {
+    for level in 0..level_count(grid.max_radius_px) {
+        let r = level_block_radius(level);
         for o in 0..set.objects.count {
-            let k = set.kernel(r, o);
+            let k = set.kernel(level, o);
             assert_eq!(k.len(), kernel_side(r) * kernel_side(r));
             for c in 0..3 {
                 let s: f64 = k.iter().map(|t| f64::from(t[c])).sum();

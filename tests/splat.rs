@@ -8,7 +8,9 @@ use common::splat_cpu;
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::gpu::texture_probe::TextureProbe;
 use ocular::gpu::Context;
-use ocular::psf::kernels::{kernel_side, DioptreAxis, KernelGrid};
+use ocular::psf::kernels::{
+    kernel_side, level_block_radius, level_of_radius, DioptreAxis, KernelGrid,
+};
 use ocular::render::reference;
 use ocular::render::splat::{
     FrameInput, MergeSettings, PsfTextureFormat, SplatOutput, SplatSettings, Splatter, ViewState,
@@ -183,11 +185,12 @@ fn psf_texture_matches_cpu_blend_of_four_grid_states() {
         let mut worst = 0.0f32;
         for (p, s) in points.iter().zip(&samples) {
             let (x, y, z) = (p[0] as i64, p[1] as i64, p[2] as usize);
-            let (r, o) = ((z / objects.count) as u32, z % objects.count);
+            let (level, o) = ((z / objects.count) as u32, z % objects.count);
+            let r = level_block_radius(level);
             let (dx, dy) = (x - rmax, y - rmax);
             let want = if dx.abs() <= r as i64 && dy.abs() <= r as i64 {
                 let side = kernel_side(r);
-                let texel = expected.kernel(r, o)
+                let texel = expected.kernel(level, o)
                     [(dy + r as i64) as usize * side + (dx + r as i64) as usize];
                 texel.map(|v| v * (side * side) as f32)
             } else {
@@ -240,18 +243,21 @@ fn blurred_point_over_sharp_background_renders_as_its_kernel() {
     let mut peak = 0.0f32;
     for (c, &white_c) in white.iter().enumerate() {
         let radius = set.radius_px[o0][c] * (1.0 - t) + set.radius_px[o1][c] * t;
+        // The two radius levels around the radius, blended by the fraction between them.
+        let level = level_of_radius(f64::from(radius));
         let (r0, r1, tr) = (
-            radius.floor() as u32,
-            radius.ceil() as u32,
-            radius - radius.floor(),
+            level.floor() as u32,
+            level.ceil() as u32,
+            (level - level.floor()) as f32,
         );
-        let weight_at = |r: u32, dx: i64, dy: i64| -> f32 {
+        let weight_at = |l: u32, dx: i64, dy: i64| -> f32 {
+            let r = level_block_radius(l);
             if dx.abs() > r as i64 || dy.abs() > r as i64 {
                 return 0.0;
             }
             let side = kernel_side(r);
             let i = (dy + r as i64) as usize * side + (dx + r as i64) as usize;
-            set.kernel(r, o0)[i][c] * (1.0 - t) + set.kernel(r, o1)[i][c] * t
+            set.kernel(l, o0)[i][c] * (1.0 - t) + set.kernel(l, o1)[i][c] * t
         };
         for y in 0..60i64 {
             for x in 0..80i64 {

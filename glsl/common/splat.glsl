@@ -67,6 +67,34 @@ vec2 kernel_offset(vec2 e, vec2 c, vec2 d) {
     return c.y * d + (c.x - c.y) * dot(d, e) * e;
 }
 
+// Radius levels of the kernel blocks (src/psf/kernels.rs): quarter pixels up to 2 px, whole
+// pixels beyond; level l has a block of radius ceil(level_radius(l)).
+const uint LEVELS_PER_PX = 4u;
+const uint FINE_UNTIL_PX = 2u;
+const uint FINE_LEVELS = LEVELS_PER_PX * FINE_UNTIL_PX;
+
+uint level_count() {
+    return frame.max_radius <= FINE_UNTIL_PX ? frame.max_radius * LEVELS_PER_PX + 1u
+                                             : FINE_LEVELS + (frame.max_radius - FINE_UNTIL_PX) + 1u;
+}
+
+float level_radius(uint level) {
+    return level <= FINE_LEVELS ? float(level) / float(LEVELS_PER_PX)
+                                : float(FINE_UNTIL_PX + level - FINE_LEVELS);
+}
+
+uint level_block_radius(uint level) {
+    return level <= FINE_LEVELS ? (level + LEVELS_PER_PX - 1u) / LEVELS_PER_PX
+                                : FINE_UNTIL_PX + level - FINE_LEVELS;
+}
+
+// Continuous level of a kernel radius (what the convolution interpolates on).
+vec3 level_of_radius(vec3 r) {
+    vec3 fine = r * float(LEVELS_PER_PX);
+    vec3 coarse = vec3(float(FINE_LEVELS)) + r - vec3(float(FINE_UNTIL_PX));
+    return mix(fine, coarse, step(vec3(float(FINE_UNTIL_PX)) + 1e-6, r));
+}
+
 // How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.
 // Kernels of radius r occupy (2r+1)² texels centred on the fragment; a merged fragment sits
 // half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further. Off

@@ -50,6 +50,8 @@ pub struct BenchArgs {
     /// Fragment merging: 0 = off, 1 = 2×2, 2 = also 4×4.
     #[arg(long, default_value_t = 1)]
     pub merge_levels: u32,
+    #[command(flatten)]
+    pub blend: super::BlendArgs,
     /// Also time the ground truth and the slice method once each, and print speed ratios.
     #[arg(long)]
     pub compare_methods: bool,
@@ -143,6 +145,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
             levels: args.merge_levels,
             ..MergeSettings::default()
         },
+        &args.blend,
     )?;
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;

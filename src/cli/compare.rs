@@ -47,6 +47,8 @@ pub struct CompareArgs {
     pub texture_format: PsfTextureFormat,
     #[arg(long, default_value_t = 1)]
     pub merge_levels: u32,
+    #[command(flatten)]
+    pub blend: super::BlendArgs,
     /// Merge a block only if its smallest blur radius is at least this (px).
     #[arg(long, default_value_t = 5.0)]
     pub merge_min_radius: f32,
@@ -129,6 +131,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             color_tolerance: args.merge_color_tolerance,
             ..MergeSettings::default()
         },
+        &args.blend,
     )?;
     if args.slices == 0 {
         return Err(Error::input("--slices must be at least 1"));

@@ -81,23 +81,53 @@ pub fn run(cli: Cli) -> Result<()> {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
-/// reader never sees a partial file and a failed run leaves no file behind.
+/// How fragments combine and the wide-field geometry (render, bench, compare).
+#[derive(Debug, Clone, clap::Args)]
+pub struct BlendArgs {
+    /// How the fragments reaching a pixel combine: `grouped` adds the fragments of one depth
+    /// group linearly and composites groups front to back (conserves light: a plane is its
+    /// convolution); `per-fragment` is the seed paper's blend, kept for comparison.
+    #[arg(long, value_enum, default_value = "grouped")]
+    pub blend: crate::render::blend::BlendMode,
+    /// Largest vergence step (D) between consecutive fragments of one depth group.
+    #[arg(long, value_name = "D", default_value_t = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D)]
+    pub group_tolerance_d: f32,
+    /// Use the seed paper's narrow-field geometry: vergence from view-axis depth and every
+    /// kernel at the image centre's scale (default: vergence along each pixel's ray and
+    /// kernels at the pinhole's local scale, which a wide field of view needs).
+    #[arg(long)]
+    pub narrow_field: bool,
+}
+
+impl BlendArgs {
+    pub fn settings(&self) -> crate::render::blend::BlendSettings {
+        crate::render::blend::BlendSettings {
+            mode: self.blend,
+            group_tolerance_d: self.group_tolerance_d,
+            wide_field: !self.narrow_field,
+        }
+    }
+}
+
 /// Splat settings from the command line, validated (errors name the options).
 pub(crate) fn splat_settings(
     tile_size: u32,
     texture_format: crate::render::splat::PsfTextureFormat,
     merge: crate::render::splat::MergeSettings,
+    blend: &BlendArgs,
 ) -> Result<crate::render::splat::SplatSettings> {
     let settings = crate::render::splat::SplatSettings {
         tile_size,
         texture_format,
         merge,
+        blend: blend.settings(),
         ..crate::render::splat::SplatSettings::default()
     };
-    settings
-        .validate()
-        .map_err(|e| crate::Error::input(format!("--tile-size / --merge-*: {e}")))?;
+    settings.validate().map_err(|e| {
+        crate::Error::input(format!(
+            "--tile-size / --merge-* / --group-tolerance-d: {e}"
+        ))
+    })?;
     Ok(settings)
 }
 
@@ -151,6 +181,8 @@ pub(crate) fn measured_scene_frame(
     ))
 }
 
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
+/// reader never sees a partial file and a failed run leaves no file behind.
 pub(crate) fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     crate::image_io::write_atomic(path, |w| {
         std::io::Write::write_all(w, bytes).map_err(|e| format!("cannot write: {e}"))

@@ -104,6 +104,8 @@ pub struct RenderArgs {
     /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4.
     #[arg(long, default_value_t = 1)]
     pub merge_levels: u32,
+    #[command(flatten)]
+    pub blend: super::BlendArgs,
     /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
@@ -352,6 +354,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             levels: args.merge_levels,
             ..MergeSettings::default()
         },
+        &args.blend,
     )?;
     let eye = load_eye(&args.eye)?;
     let ctx = Context::new(&cli.context_options())?;

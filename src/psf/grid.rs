@@ -8,7 +8,9 @@
 
 use super::axes::{GridAxes, KernelSettings, Screen};
 use super::defocus::ColumnOptics;
-use super::kernels::{kernel_side, KernelGrid, KernelSet};
+use super::kernels::{
+    kernel_side, level_block_radius, level_count, level_radius_px, KernelGrid, KernelSet,
+};
 use super::project::{cropped_psf, CroppedPsf};
 use crate::eye::Eye;
 use crate::{Error, Result};
@@ -177,26 +179,28 @@ pub fn kernels_from_columns(
                     psf(s, c, o).natural_radius_px().min(max_radius as f64) as f32;
             }
         }
-        // Blocks are laid out radius-major: split the texels into one slice per (r, o).
+        // Blocks are laid out level-major: split the texels into one slice per (level, o).
+        let levels = level_count(max_radius);
         let mut blocks: Vec<(u32, usize, &mut [[f32; 3]])> = Vec::new();
         let mut rest: &mut [[f32; 3]] = &mut set.texels;
-        for r in 0..=max_radius {
-            let n = kernel_side(r) * kernel_side(r);
+        for level in 0..levels {
+            let n = kernel_side(level_block_radius(level)).pow(2);
             for o in 0..no {
                 let (head, tail) = rest.split_at_mut(n);
-                blocks.push((r, o, head));
+                blocks.push((level, o, head));
                 rest = tail;
             }
         }
-        // Group by object so progress counts (set, object) units; radii run in parallel.
-        blocks.par_iter_mut().for_each(|(r, o, block)| {
+        // Group by object so progress counts (set, object) units; levels run in parallel.
+        blocks.par_iter_mut().for_each(|(level, o, block)| {
+            let (radius, support) = (level_block_radius(*level), level_radius_px(*level) + 0.5);
             for c in 0..3 {
-                let k = psf(s, c, *o).resample(*r, *r as f64 + 0.5);
+                let k = psf(s, c, *o).resample(radius, support);
                 for (t, v) in block.iter_mut().zip(&k) {
                     t[c] = *v as f32;
                 }
             }
-            if *r == max_radius {
+            if *level == levels - 1 {
                 progress(
                     Stage::Kernels,
                     done.fetch_add(1, Ordering::Relaxed) + 1,

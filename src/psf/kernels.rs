@@ -3,12 +3,18 @@
 //!
 //! For one (pupil, focus) state, every object distance `o` on a uniform dioptre axis has a
 //! natural projected PSF radius per channel (in pixels, unrounded) and its PSF resampled to
-//! EVERY integer radius `r = 0..=Rmax`: at run time a fragment's radius is interpolated between
-//! neighbouring object distances and then looked up at floor/ceil radius, so each PSF shape is
+//! EVERY radius level: at run time a fragment's radius is interpolated between neighbouring
+//! object distances and then looked up at the two levels around it, so each PSF shape is
 //! needed at radii other than its own.
 //!
-//! Storage order follows the PSF texture (layer = r·No + o): blocks by radius, then object
-//! distance; within a block (2r+1)² texels row-major, each an RGB triple (one channel per
+//! Radius levels step by a quarter pixel up to [`FINE_UNTIL_PX`] and by whole pixels beyond
+//! (0, 0.25, …, 2, 3, …, Rmax): blending two kernels whose radii differ by a whole pixel is
+//! fine for a blurred kernel, but below about 2 px the shapes of neighbouring integer radii
+//! (a single texel and a 3×3 block) are too different for their mix to be the kernel between.
+//! Level `l` has radius [`level_radius_px`] and a block of side 2·⌈radius⌉ + 1.
+//!
+//! Storage order follows the PSF texture (layer = level·No + o): blocks by level, then object
+//! distance; within a block side² texels row-major, each an RGB triple (one channel per
 //! wavelength), each channel normalised to sum 1 over the block.
 
 /// A uniform axis of object vergences in dioptres (1/m): `min_d + i·step_d`, i < count.
@@ -54,6 +60,56 @@ pub fn texels_below_radius(r: u32) -> usize {
     r * (4 * r * r).saturating_sub(1) / 3
 }
 
+/// Radius levels per pixel below [`FINE_UNTIL_PX`], and where whole-pixel levels begin.
+/// (glsl/common/splat.glsl mirrors these.)
+pub const LEVELS_PER_PX: u32 = 4;
+pub const FINE_UNTIL_PX: u32 = 2;
+const FINE_LEVELS: u32 = LEVELS_PER_PX * FINE_UNTIL_PX;
+
+/// Number of radius levels for kernels up to `max_radius` px.
+pub fn level_count(max_radius: u32) -> u32 {
+    if max_radius <= FINE_UNTIL_PX {
+        max_radius * LEVELS_PER_PX + 1
+    } else {
+        FINE_LEVELS + (max_radius - FINE_UNTIL_PX) + 1
+    }
+}
+
+/// Kernel radius (px) of a level.
+pub fn level_radius_px(level: u32) -> f64 {
+    if level <= FINE_LEVELS {
+        f64::from(level) / f64::from(LEVELS_PER_PX)
+    } else {
+        f64::from(FINE_UNTIL_PX + level - FINE_LEVELS)
+    }
+}
+
+/// Radius of a level's block (its side is 2·radius + 1).
+pub fn level_block_radius(level: u32) -> u32 {
+    level_radius_px(level).ceil() as u32
+}
+
+/// Continuous level of a kernel radius: what the runtime interpolates on.
+pub fn level_of_radius(radius_px: f64) -> f64 {
+    let fine = f64::from(FINE_UNTIL_PX);
+    if radius_px <= fine {
+        radius_px * f64::from(LEVELS_PER_PX)
+    } else {
+        f64::from(FINE_LEVELS) + radius_px - fine
+    }
+}
+
+/// Number of texels in the blocks of all levels below `level`.
+pub fn texels_below_level(level: u32) -> usize {
+    let side2 = |l: u32| kernel_side(level_block_radius(l)).pow(2);
+    if level <= FINE_LEVELS + 1 {
+        return (0..level).map(side2).sum();
+    }
+    // Whole-pixel levels have blocks of every radius from FINE_UNTIL_PX + 1 on.
+    texels_below_level(FINE_LEVELS + 1) + texels_below_radius(level_block_radius(level))
+        - texels_below_radius(FINE_UNTIL_PX + 1)
+}
+
 /// Side of the square kernel of radius `r`.
 pub fn kernel_side(r: u32) -> usize {
     2 * r as usize + 1
@@ -75,7 +131,7 @@ pub struct KernelSet {
 impl KernelSet {
     /// Texel count of a set with `objects` object distances and radii 0..=max_radius.
     pub fn texel_count(objects: usize, max_radius: u32) -> usize {
-        objects * texels_below_radius(max_radius + 1)
+        objects * texels_below_level(level_count(max_radius))
     }
 
     /// A set of zeros, ready to be filled block by block.
@@ -95,19 +151,22 @@ impl KernelSet {
         }
     }
 
-    /// Index of the first texel of the block for radius `r` and object distance `object`.
-    pub fn block_offset(&self, r: u32, object: usize) -> usize {
-        self.objects.count * texels_below_radius(r) + object * kernel_side(r) * kernel_side(r)
+    /// Index of the first texel of the block for radius `level` and object distance `object`.
+    pub fn block_offset(&self, level: u32, object: usize) -> usize {
+        let side = kernel_side(level_block_radius(level));
+        self.objects.count * texels_below_level(level) + object * side * side
     }
 
-    pub fn kernel(&self, r: u32, object: usize) -> &[[f32; 3]] {
-        let start = self.block_offset(r, object);
-        &self.texels[start..start + kernel_side(r) * kernel_side(r)]
+    /// The block of a radius level (side 2·[`level_block_radius`] + 1).
+    pub fn kernel(&self, level: u32, object: usize) -> &[[f32; 3]] {
+        let start = self.block_offset(level, object);
+        let side = kernel_side(level_block_radius(level));
+        &self.texels[start..start + side * side]
     }
 
-    pub fn kernel_mut(&mut self, r: u32, object: usize) -> &mut [[f32; 3]] {
-        let start = self.block_offset(r, object);
-        let side = kernel_side(r);
+    pub fn kernel_mut(&mut self, level: u32, object: usize) -> &mut [[f32; 3]] {
+        let start = self.block_offset(level, object);
+        let side = kernel_side(level_block_radius(level));
         &mut self.texels[start..start + side * side]
     }
 
@@ -282,13 +341,36 @@ mod tests {
     fn blocks_tile_the_texel_array_without_gaps() {
         let set = KernelSet::zeroed(4.0, 0.0, DioptreAxis::spanning(0.0, 2.0, 5), 6);
         let mut expected = 0;
-        for r in 0..=6 {
+        for level in 0..level_count(6) {
             for o in 0..5 {
-                assert_eq!(set.block_offset(r, o), expected);
-                expected += kernel_side(r) * kernel_side(r);
+                assert_eq!(set.block_offset(level, o), expected);
+                expected += kernel_side(level_block_radius(level)).pow(2);
             }
         }
         assert_eq!(expected, set.texels.len());
+        assert_eq!(level_count(6), 13);
+        assert_eq!(level_radius_px(12), 6.0);
+    }
+
+    #[test]
+    fn levels_step_by_quarter_pixels_then_whole_pixels() {
+        let radii: Vec<f64> = (0..level_count(4)).map(level_radius_px).collect();
+        assert_eq!(
+            radii,
+            [0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0, 3.0, 4.0]
+        );
+        for (l, r) in radii.iter().enumerate() {
+            assert_eq!(level_of_radius(*r), l as f64);
+        }
+        assert_eq!(level_of_radius(2.5), 8.5);
+        assert_eq!(level_of_radius(0.1), 0.4);
+        // The closed form agrees with a direct sum at every level.
+        for level in 0..60 {
+            let direct: usize = (0..level)
+                .map(|l| kernel_side(level_block_radius(l)).pow(2))
+                .sum();
+            assert_eq!(texels_below_level(level), direct, "level {level}");
+        }
     }
 
     #[test]

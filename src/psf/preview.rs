@@ -2,6 +2,7 @@
 //! the projected PSF size against object dioptres per channel for two focus states (the seed
 //! paper's Figure 7). Drawn into plain RGB buffers with a built-in 5×7 font.
 
+use super::kernels::level_of_radius;
 use super::kernels::KernelGrid;
 use crate::{Error, Result};
 use image::{Rgb, RgbImage};
@@ -190,7 +191,8 @@ pub fn contact_sheet(grid: &KernelGrid) -> RgbImage {
         let mut kernels = Vec::new();
         for c in 0..3 {
             let r = (set.radius_px[o][c].ceil() as u32).min(grid.max_radius_px);
-            let k = set.kernel(r, o);
+            // A whole radius is always a level.
+            let k = set.kernel(level_of_radius(f64::from(r)) as u32, o);
             let peak = k.iter().map(|t| t[c]).fold(0.0f32, f32::max).max(1e-12);
             kernels.push((
                 r,

@@ -4,7 +4,9 @@
 //! (so that orientation mistakes and interpolation over distance both show).
 #![allow(dead_code)]
 
-use ocular::psf::kernels::{DioptreAxis, KernelGrid, KernelSet};
+use ocular::psf::kernels::{
+    level_block_radius, level_count, level_radius_px, DioptreAxis, KernelGrid, KernelSet,
+};
 use ocular::render::reference::{ExactKernels, Kernel};
 
 #[derive(Clone, Debug)]
@@ -91,11 +93,12 @@ impl SyntheticEye {
             for c in 0..3 {
                 set.radius_px[o][c] = self.radius_px(c, d, pupil_mm).min(max_radius as f64) as f32;
             }
-            for r in 0..=max_radius {
+            for level in 0..level_count(max_radius) {
+                let (half_width, r) = (level_radius_px(level) + 0.5, level_block_radius(level));
                 let per_channel: Vec<Vec<f32>> = (0..3)
-                    .map(|c| self.kernel_values(c, d, r as f64 + 0.5, r))
+                    .map(|c| self.kernel_values(c, d, half_width, r))
                     .collect();
-                for (t, texel) in set.kernel_mut(r, o).iter_mut().enumerate() {
+                for (t, texel) in set.kernel_mut(level, o).iter_mut().enumerate() {
                     *texel = [per_channel[0][t], per_channel[1][t], per_channel[2][t]];
                 }
             }

@@ -31,24 +31,25 @@ shared vec4 batch_reach[64];   // centre.xy, reach, 1 when the local scale appli
 shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shrink
 shared Fragment batch[64];
 
-// RGB kernel values at integer radius r (divided by the (2r+1)² storage scale).
-vec3 kernel_rgb(vec2 d, float r, float index) {
+// RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block).
+vec3 kernel_rgb(vec2 d, float l, float index) {
     float side = float(2u * frame.max_radius + 1u);
-    float layers = float(frame.object_count * (frame.max_radius + 1u));
+    float layers = float(frame.object_count * level_count());
     vec3 uvw = vec3((float(frame.max_radius) + 0.5 + d) / side,
-                    (r * float(frame.object_count) + index + 0.5) / layers);
-    float k = 2.0 * r + 1.0;
+                    (l * float(frame.object_count) + index + 0.5) / layers);
+    float k = float(2u * level_block_radius(uint(l)) + 1u);
     return textureLod(psf_texture, uvw, 0.0).rgb / (k * k);
 }
 
-// Per-channel weight of fragment f at offset d: each channel's radius lies between two integer
-// radii; when all channels' radii fall within three consecutive integers (the usual case), the
+// Per-channel weight of fragment f at offset d: each channel's radius lies between two radius
+// levels; when all channels' levels fall within three consecutive ones (the usual case), the
 // three lookups serve every channel, else each channel takes its own two.
 vec3 fragment_weight(Fragment f, vec2 d) {
-    vec3 lo = floor(f.radius);
-    vec3 t = f.radius - lo;
+    vec3 level = level_of_radius(f.radius);
+    vec3 lo = floor(level);
+    vec3 t = level - lo;
     float base = min(lo.r, min(lo.g, lo.b));
-    float top = max(ceil(f.radius.r), max(ceil(f.radius.g), ceil(f.radius.b)));
+    float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
     vec3 w;
     if (top - base <= 2.0) {
         vec3 s0 = kernel_rgb(d, base, f.index);

@@ -1,8 +1,9 @@
 #version 460
 // Builds the per-frame PSF texture: kernels of up to four (pupil, focus) grid states blended
-// with bilinear weights, laid out as layer = r·No + o, each (2r+1)² block centred at texel Rmax,
-// every other texel zero. Values are scaled by (2r+1)² so that half floats keep their precision
-// (a kernel's mean texel becomes ~1); the convolution pass divides it back out.
+// with bilinear weights, laid out as layer = level·No + o, each level's (2r+1)² block (r its
+// block radius) centred at texel Rmax, every other texel zero. Values are scaled by (2r+1)² so
+// that half floats keep their precision (a kernel's mean texel becomes ~1); the convolution
+// pass divides it back out.
 #extension GL_GOOGLE_include_directive : require
 #include "splat.glsl"
 
@@ -15,31 +16,50 @@ layout(std430, binding = 2) readonly buffer Set2 { float set2[]; };
 layout(std430, binding = 3) readonly buffer Set3 { float set3[]; };
 layout(binding = 4) writeonly uniform image3D psf_texture;
 
-// pass_f: the four corner weights; pass_u: (first radius, end radius, first texel) of the chunk.
+// pass_f: the four corner weights; pass_u: (first level, end level, first texel) of the chunk.
 #define WEIGHTS frame.pass_f
-#define FIRST_RADIUS frame.pass_u.x
-#define END_RADIUS frame.pass_u.y
+#define FIRST_LEVEL frame.pass_u.x
+#define END_LEVEL frame.pass_u.y
 #define FIRST_TEXEL frame.pass_u.z
 
 uint texels_below(uint r) {
     return r * (4u * r * r - 1u) / 3u;
 }
 
+// Texels in the blocks of all levels below `level` (psf::kernels::texels_below_level).
+uint fine_texels_below(uint level) {
+    uint n = 0u;
+    for (uint l = 0u; l < level; l++) {
+        uint side = 2u * level_block_radius(l) + 1u;
+        n += side * side;
+    }
+    return n;
+}
+
+uint texels_below_level(uint level) {
+    if (level <= FINE_LEVELS + 1u) {
+        return fine_texels_below(level);
+    }
+    return fine_texels_below(FINE_LEVELS + 1u) + texels_below(level_block_radius(level))
+        - texels_below(FINE_UNTIL_PX + 1u);
+}
+
 void main() {
     uint side = 2u * frame.max_radius + 1u;
     uvec3 id = gl_GlobalInvocationID;
-    uint layer = FIRST_RADIUS * frame.object_count + id.z;
-    if (id.x >= side || id.y >= side || layer >= END_RADIUS * frame.object_count) {
+    uint layer = FIRST_LEVEL * frame.object_count + id.z;
+    if (id.x >= side || id.y >= side || layer >= END_LEVEL * frame.object_count) {
         return;
     }
-    uint r = layer / frame.object_count;
+    uint level = layer / frame.object_count;
+    uint r = level_block_radius(level);
     uint o = layer % frame.object_count;
     int dx = int(id.x) - int(frame.max_radius);
     int dy = int(id.y) - int(frame.max_radius);
     vec3 value = vec3(0.0);
     if (abs(dx) <= int(r) && abs(dy) <= int(r)) {
         uint kside = 2u * r + 1u;
-        uint texel = frame.object_count * texels_below(r) + o * kside * kside
+        uint texel = frame.object_count * texels_below_level(level) + o * kside * kside
             + uint(dy + int(r)) * kside + uint(dx + int(r)) - FIRST_TEXEL;
         uint i = 3u * texel;
         value = WEIGHTS.x * vec3(set0[i], set0[i + 1u], set0[i + 2u]);

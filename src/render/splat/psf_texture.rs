@@ -5,7 +5,7 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage, Recorder,
     TexelFormat,
 };
-use crate::psf::kernels::{texels_below_radius, GridBlend, KernelGrid, KernelSet};
+use crate::psf::kernels::{level_count, texels_below_level, GridBlend, KernelGrid, KernelSet};
 
 use super::FrameParams;
 
@@ -39,7 +39,7 @@ pub fn texture_extent(grid: &KernelGrid) -> [u32; 3] {
     [
         side,
         side,
-        grid.objects.count as u32 * (grid.max_radius_px + 1),
+        grid.objects.count as u32 * level_count(grid.max_radius_px),
     ]
 }
 
@@ -61,11 +61,11 @@ pub(super) fn create_texture(
     )
 }
 
-/// One set's texels for the radii [first_radius, end_radius), small enough for one binding.
+/// One set's texels for the radii [first_level, end_level), small enough for one binding.
 pub(super) struct Chunk {
     buffer: Buffer,
-    first_radius: u32,
-    end_radius: u32,
+    first_level: u32,
+    end_level: u32,
     first_texel: u32,
 }
 
@@ -77,14 +77,16 @@ pub(super) struct ResidentGrid {
 }
 
 /// Radius ranges whose texels fit `limit_bytes` each.
+/// Ranges of radius levels whose texels fit one storage-buffer binding.
 fn chunk_ranges(objects: usize, max_radius: u32, limit_bytes: u64) -> Vec<(u32, u32)> {
     let bytes_of =
-        |a: u32, b: u32| (objects * (texels_below_radius(b) - texels_below_radius(a))) as u64 * 12;
+        |a: u32, b: u32| (objects * (texels_below_level(b) - texels_below_level(a))) as u64 * 12;
+    let levels = level_count(max_radius);
     let mut ranges = Vec::new();
     let mut start = 0;
-    while start <= max_radius {
+    while start < levels {
         let mut end = start + 1;
-        while end <= max_radius && bytes_of(start, end + 1) <= limit_bytes {
+        while end < levels && bytes_of(start, end + 1) <= limit_bytes {
             end += 1;
         }
         ranges.push((start, end));
@@ -117,17 +119,17 @@ fn upload_set(
     ranges
         .iter()
         .map(|&(a, b)| {
-            let first = objects * texels_below_radius(a);
-            let end = objects * texels_below_radius(b);
+            let first = objects * texels_below_level(a);
+            let end = objects * texels_below_level(b);
             let buffer = Buffer::from_slice(
                 ctx,
-                &format!("kernel set {index} radii {a}..{b}"),
+                &format!("kernel set {index} radius levels {a}..{b}"),
                 &set.texels[first..end],
             )?;
             Ok(Chunk {
                 buffer,
-                first_radius: a,
-                end_radius: b,
+                first_level: a,
+                end_level: b,
                 first_texel: first as u32,
             })
         })
@@ -171,9 +173,9 @@ impl PsfTexturePass {
             let weight = |k: usize| blend.corners.get(k).map_or(0.0, |c| c.1 as f32);
             let first = corner(0);
             let mut p = *params;
-            p.pass_u = [first.first_radius, first.end_radius, first.first_texel, 0];
+            p.pass_u = [first.first_level, first.end_level, first.first_texel, 0];
             p.pass_f = [weight(0), weight(1), weight(2), weight(3)];
-            let layers = (first.end_radius - first.first_radius) * params.object_count;
+            let layers = (first.end_level - first.first_level) * params.object_count;
             rec.dispatch(
                 &self.pipeline,
                 &[
@@ -196,16 +198,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn chunks_cover_all_radii_within_the_limit() {
+    fn chunks_cover_all_levels_within_the_limit() {
         for limit in [1u64 << 10, 1 << 16, 128 << 20] {
             let ranges = chunk_ranges(41, 48, limit);
             assert_eq!(ranges.first().unwrap().0, 0);
-            assert_eq!(ranges.last().unwrap().1, 49);
+            assert_eq!(ranges.last().unwrap().1, level_count(48));
             for w in ranges.windows(2) {
                 assert_eq!(w[0].1, w[1].0);
             }
             for &(a, b) in &ranges {
-                let bytes = (41 * (texels_below_radius(b) - texels_below_radius(a))) as u64 * 12;
+                let bytes = (41 * (texels_below_level(b) - texels_below_level(a))) as u64 * 12;
                 assert!(bytes <= limit || b == a + 1, "{a}..{b}: {bytes} > {limit}");
             }
         }
