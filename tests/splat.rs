@@ -498,8 +498,13 @@ fn every_pass_matches_its_cpu_step() {
         focal_px: (32.0 / 30f64.to_radians().tan()) as f32,
     };
     let mut cpu = splat_cpu::fragments(&frame, &scene.color, &scene.depth, &grid.sets[0].radius_px);
-    splat_cpu::merge_level(&frame, &mut cpu, &merge, 2);
-    splat_cpu::merge_level(&frame, &mut cpu, &merge, 4);
+    let core: Vec<f32> = grid.sets[0]
+        .core_radii_px()
+        .iter()
+        .map(|c| c[0].min(c[1]).min(c[2]))
+        .collect();
+    splat_cpu::merge_level(&frame, &mut cpu, &merge, &core, 2);
+    splat_cpu::merge_level(&frame, &mut cpu, &merge, &core, 4);
     let merged = cpu.iter().filter(|f| f.size > 1).count();
     assert!(
         merged > 20,

@@ -170,6 +170,30 @@ impl KernelSet {
         &mut self.texels[start..start + side * side]
     }
 
+    /// Per object distance and channel, the radius of the uniform disc with the same r50 as
+    /// the kernel at its natural radius (√2·r50, about the centroid): how blurred a kernel's
+    /// core is. For a defocus disc it is the natural radius; for a PSF with a sharp core and a
+    /// wide flare (coma, keratoconus) it is far smaller, and that core is what averaging a
+    /// block of fragments would smear.
+    pub fn core_radii_px(&self) -> Vec<[f32; 3]> {
+        let levels = level_count(self.max_radius_px);
+        (0..self.objects.count)
+            .map(|o| {
+                [0, 1, 2].map(|c| {
+                    let natural = f64::from(self.radius_px[o][c]);
+                    let level = (level_of_radius(natural).round() as u32).min(levels - 1);
+                    let r = level_block_radius(level);
+                    let values: Vec<f64> = self
+                        .kernel(level, o)
+                        .iter()
+                        .map(|t| f64::from(t[c]))
+                        .collect();
+                    (std::f64::consts::SQRT_2 * encircled_radius(&values, r, 0.5)) as f32
+                })
+            })
+            .collect()
+    }
+
     /// Bytes of the texels as stored for the GPU (three f32 per texel).
     pub fn size_bytes(&self) -> u64 {
         self.texels.len() as u64 * 12
@@ -204,6 +228,42 @@ impl KernelSet {
         }
         Ok(())
     }
+}
+
+/// Radius about the centroid of a square kernel (side 2r + 1) within which `fraction` of its
+/// energy lies, interpolated between pixel-centre distances (at least half a pixel).
+pub fn encircled_radius(values: &[f64], r: u32, fraction: f64) -> f64 {
+    let side = kernel_side(r);
+    let total: f64 = values.iter().sum();
+    if total <= 0.0 || !total.is_finite() {
+        return 0.5;
+    }
+    let c = f64::from(r);
+    let (mut mx, mut my) = (0.0, 0.0);
+    for (i, v) in values.iter().enumerate() {
+        mx += v * ((i % side) as f64 - c);
+        my += v * ((i / side) as f64 - c);
+    }
+    let (mx, my) = (mx / total, my / total);
+    let mut by_distance: Vec<(f64, f64)> = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            let (x, y) = ((i % side) as f64 - c - mx, (i / side) as f64 - c - my);
+            (x.hypot(y), v / total)
+        })
+        .collect();
+    by_distance.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (mut acc, mut previous) = (0.0, 0.0);
+    for (d, v) in by_distance {
+        if acc + v >= fraction {
+            let t = if v > 0.0 { (fraction - acc) / v } else { 1.0 };
+            return (previous + t * (d - previous)).max(0.5);
+        }
+        acc += v;
+        previous = d;
+    }
+    previous.max(0.5)
 }
 
 /// Kernels over a grid of (pupil, focus) states sharing one object axis and maximum radius.
@@ -275,6 +335,19 @@ impl KernelGrid {
         let mut out = vec![[0.0f32; 3]; self.objects.count];
         for &(index, w) in &blend.corners {
             for (o, r) in self.sets[index].radius_px.iter().enumerate() {
+                for c in 0..3 {
+                    out[o][c] += (w as f32) * r[c];
+                }
+            }
+        }
+        out
+    }
+
+    /// Per-set values (one triple per object distance) blended like the kernels.
+    pub fn blend_per_object(&self, blend: &GridBlend, per_set: &[Vec<[f32; 3]>]) -> Vec<[f32; 3]> {
+        let mut out = vec![[0.0f32; 3]; self.objects.count];
+        for &(index, w) in &blend.corners {
+            for (o, r) in per_set[index].iter().enumerate() {
                 for c in 0..3 {
                     out[o][c] += (w as f32) * r[c];
                 }

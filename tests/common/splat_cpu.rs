@@ -82,7 +82,20 @@ pub fn fragments(
 }
 
 /// One merge level (block `size` 2 or 4) following the rules in merge.comp's header.
-pub fn merge_level(frame: &Frame, fragments: &mut [Fragment], settings: &MergeSettings, size: u32) {
+/// `core`: per object distance, the smallest core radius over the channels (merge.comp).
+pub fn merge_level(
+    frame: &Frame,
+    fragments: &mut [Fragment],
+    settings: &MergeSettings,
+    core: &[f32],
+    size: u32,
+) {
+    let core_of = |f: &Fragment| {
+        let i0 = f.index.floor() as usize;
+        let i1 = (i0 + 1).min(core.len() - 1);
+        let t = f.index - i0 as f32;
+        core[i0] * (1.0 - t) + core[i1] * t
+    };
     let child = size / 2;
     let w = frame.width;
     for by in 0..frame.height / size {
@@ -95,7 +108,7 @@ pub fn merge_level(frame: &Frame, fragments: &mut [Fragment], settings: &MergeSe
             }
             let r_min = f
                 .iter()
-                .flat_map(|x| x.radius)
+                .flat_map(|x| x.radius.into_iter().chain([core_of(x)]))
                 .fold(f32::INFINITY, f32::min);
             if r_min < settings.min_radius_px {
                 continue;
@@ -121,8 +134,14 @@ pub fn merge_level(frame: &Frame, fragments: &mut [Fragment], settings: &MergeSe
             m.depth = f.iter().map(|x| x.depth).fold(f32::INFINITY, f32::min);
             m.index = 0.25 * f.iter().map(|x| x.index).sum::<f32>();
             m.dioptre = 0.25 * f.iter().map(|x| x.dioptre).sum::<f32>();
-            // Second-moment match of the s×s block: R'² = R² + (s² − c²)/3.
-            let grow = (size * size - child * child) as f32 / 3.0;
+            // A 2×2 block keeps its children's kernel (the bilinear lookup half a pixel off the
+            // grid averages it over the four pixels); a 4×4 block matches the second moment of
+            // its four 2×2 blocks: R'² = R² + (s² − c²)/3.
+            let grow = if size == 2 {
+                0.0
+            } else {
+                (size * size - child * child) as f32 / 3.0
+            };
             m.radius = [0, 1, 2].map(|c| {
                 let r = f.iter().map(|x| x.radius[c]).fold(0.0, f32::max);
                 (r * r + grow).sqrt().min(frame.max_radius as f32)

@@ -9,7 +9,16 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = 0) buffer Fragments { Fragment fragments[]; };
+// Per object distance: natural radius per channel (xyz) and the smallest core radius (w).
+layout(std430, binding = 0) readonly buffer Radii { vec4 radii[]; };
+layout(std430, binding = 1) buffer Fragments { Fragment fragments[]; };
+
+// Core radius (√2·r50) of a fragment's kernels, interpolated like its radius.
+float core_radius(Fragment f) {
+    uint i0 = uint(floor(f.index));
+    uint i1 = min(i0 + 1u, frame.object_count - 1u);
+    return mix(radii[i0].w, radii[i1].w, f.index - float(i0));
+}
 
 float min3(vec3 v) { return min(v.x, min(v.y, v.z)); }
 float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
@@ -34,9 +43,11 @@ void main() {
             return; // a child was not (or differently) merged
         }
     }
+    // How blurred the block is: its kernels' smallest core radius, not their full extent (a
+    // PSF with a sharp core and a wide flare must not merge: averaging would smear the core).
     float r_min = 1e30;
     for (int k = 0; k < 4; k++) {
-        r_min = min(r_min, min3(f[k].radius));
+        r_min = min(r_min, min(min3(f[k].radius), core_radius(f[k])));
     }
     if (r_min < frame.merge_min_radius) {
         return;
@@ -59,11 +70,13 @@ void main() {
     m.depth = min(min(f[0].depth, f[1].depth), min(f[2].depth, f[3].depth));
     m.index = 0.25 * (f[0].index + f[1].index + f[2].index + f[3].index);
     vec3 r_max = max(max(f[0].radius, f[1].radius), max(f[2].radius, f[3].radius));
-    // The block spreads its light over size × size pixels: match the second moment of the
-    // kernel convolved with that block. A block of s×s points adds a variance of (s² − 1)/12
-    // per axis and a disc of radius R has R²/4, so R'² = R² + (s² − 1)/3; children of size c
-    // already carry (c² − 1)/3. (The seed paper adds √2·(s − 1)/2 instead, which over-blurs.)
-    float grow = float(size * size - child * child) / 3.0;
+    // The block spreads its light over size × size pixels. A 2×2 block's centre lies half a
+    // pixel off the pixel grid, so the convolution's bilinear lookup there averages the kernel
+    // over the four pixels' offsets: the kernel itself, unscaled, is exact (scaling it would
+    // also scale an asymmetric PSF's centroid offset). A 4×4 block of four 2×2 blocks adds
+    // their ±1 px spread: match the second moment (a disc of radius R has R²/4 per axis), so
+    // R'² = R² + 4 = R² + (s² − c²)/3. (The seed paper adds √2·(s − 1)/2, which over-blurs.)
+    float grow = size == 2u ? 0.0 : float(size * size - child * child) / 3.0;
     m.radius = min(sqrt(r_max * r_max + grow), vec3(float(frame.max_radius)));
     m.center = vec2(origin) + 0.5 * float(size);
     m.size = size;

@@ -12,7 +12,7 @@ pub(super) struct MergePass {
 impl MergePass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("merge", crate::shaders::RENDER_SPLAT_MERGE_COMP)
-            .bindings(&[BindingKind::StorageBuffer])
+            .bindings(&[BindingKind::StorageBuffer, BindingKind::StorageBuffer])
             .push_constants::<FrameParams>()
             .build(ctx)?;
         Ok(MergePass { pipeline })
@@ -24,6 +24,7 @@ impl MergePass {
         rec: &mut Recorder<'_>,
         params: &FrameParams,
         levels: u32,
+        radii: &Buffer,
         fragments: &Buffer,
     ) -> GpuResult<()> {
         for level in 1..=levels {
@@ -33,7 +34,7 @@ impl MergePass {
             let blocks = [params.width / size, params.height / size];
             rec.dispatch(
                 &self.pipeline,
-                &[Binding::Buffer(fragments)],
+                &[Binding::Buffer(radii), Binding::Buffer(fragments)],
                 &p,
                 [blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1],
             )?;

@@ -221,6 +221,8 @@ pub struct Splatter {
     texture: Image,
     sampler: Sampler,
     radii: Buffer,
+    /// Per set, the core radius of every object's kernels (see `KernelSet::core_radii_px`).
+    core_radii: Vec<Vec<[f32; 3]>>,
     frame: Option<FrameResources>,
     entries: Option<Buffer>,
     psf_texture: psf_texture::PsfTexturePass,
@@ -271,6 +273,7 @@ impl Splatter {
             texture,
             sampler: Sampler::linear(ctx, Edge::ZeroBorder)?,
             radii,
+            core_radii: grid.sets.iter().map(|s| s.core_radii_px()).collect(),
             frame: None,
             entries: None,
             psf_texture: psf_texture::PsfTexturePass::new(ctx)?,
@@ -430,11 +433,15 @@ impl Splatter {
         frame.color_in.upload(&ctx, input.color)?;
         frame.depth_in.upload(&ctx, input.depth_m)?;
         let blend = self.grid.blend(view.pupil_mm, view.focus_d);
+        // xyz: natural radius per channel; w: the smallest core radius over the channels,
+        // which decides merging.
+        let core = self.grid.blend_per_object(&blend, &self.core_radii);
         let radii: Vec<[f32; 4]> = self
             .grid
             .blended_radii(&blend)
             .iter()
-            .map(|r| [r[0], r[1], r[2], 0.0])
+            .zip(&core)
+            .map(|(r, k)| [r[0], r[1], r[2], k[0].min(k[1]).min(k[2])])
             .collect();
         let mut params = self.params(frame);
         params.focal_px = input.projection().focal_px() as f32;
@@ -457,8 +464,13 @@ impl Splatter {
             )?;
             if self.settings.merge.levels > 0 {
                 rec.begin_pass("merge");
-                self.merge
-                    .record(rec, &params, self.settings.merge.levels, &frame.fragments)?;
+                self.merge.record(
+                    rec,
+                    &params,
+                    self.settings.merge.levels,
+                    &self.radii,
+                    &frame.fragments,
+                )?;
             }
             rec.begin_pass("tile count");
             rec.fill_buffer(&frame.counts, 0);
