@@ -109,8 +109,16 @@ struct Report {
     focus_d: f64,
     pupil_mm: f64,
     device: String,
+    /// What the ground truth shares with splat (what it cannot judge).
+    truth_shares: &'static str,
     methods: Vec<MethodResult>,
 }
+
+/// What the ground truth has in common with splat, printed with every comparison.
+const TRUTH_SHARES: &str = "ground truth: the exact PSF of every pixel's vergence; it shares the \
+blend (depth groups), the pinhole's local layout and the PSFs with splat, so it judges splat's \
+kernel approximations (interpolation over distance and radius, merging, half-float texels), \
+not the blend or the optics";
 
 /// The displayed image: linear values scaled by the exposure, clamped to [0, 1].
 fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
@@ -245,6 +253,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         args.eye,
         ctx.device_info().name
     );
+    println!("  {TRUTH_SHARES}");
     println!(
         "  {:<10} {:>10} {:>10} {:>10} {:>12}",
         "method", "PSNR dB", "MSSIM", "seconds", "× faster"
@@ -305,6 +314,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             focus_d,
             pupil_mm,
             device: ctx.device_info().name.clone(),
+            truth_shares: TRUTH_SHARES,
             methods,
         };
         let text = serde_json::to_string_pretty(&report)
