@@ -36,6 +36,10 @@ layout(push_constant) uniform FrameParams {
     float group_tolerance_d;
     uint blend_mode;       // 0 = depth groups, 1 = the seed paper's per-fragment blend
     uint wide_field;       // 1 = vergence along rays and kernels at the local pinhole scale
+    uint entry_capacity;   // entries the list buffer holds: lists past it are not touched
+    float saturation_epsilon; // convolution stops once every pixel's coverage is ≥ 1 − ε
+    uint pad0;
+    uint pad1;
     uvec4 pass_u;          // pass-specific values (see each pass)
     vec4 pass_f;
 } frame;
@@ -129,6 +133,13 @@ ivec4 fragment_tiles(Fragment f) {
 // the fragment index, so that equal depths sort deterministically.
 uvec2 entry_key(float depth, uint fragment) {
     return uvec2(floatBitsToUint(max(depth, 0.0)), fragment);
+}
+
+// A tile's list lies wholly inside the list buffer (a frame recorded in one submission with a
+// list buffer from an earlier frame may overflow it; the host then renders it again in bands).
+bool list_fits(uint offset, uint count) {
+    uint start = offset - frame.band_first_entry;
+    return start <= frame.entry_capacity && count <= frame.entry_capacity - start;
 }
 
 bool key_less(uvec2 a, uvec2 b) {

@@ -331,9 +331,28 @@ impl<'a> Recorder<'a> {
     }
 
     pub fn copy_buffer(&mut self, src: &Buffer, dst: &Buffer, size_bytes: u64) {
+        self.copy_buffer_region(src, 0, dst, 0, size_bytes);
+    }
+
+    /// Copies `size_bytes` from `src` at `src_offset` to `dst` at `dst_offset`.
+    pub fn copy_buffer_region(
+        &mut self,
+        src: &Buffer,
+        src_offset: u64,
+        dst: &Buffer,
+        dst_offset: u64,
+        size_bytes: u64,
+    ) {
+        assert!(
+            src_offset + size_bytes <= src.size_bytes()
+                && dst_offset + size_bytes <= dst.size_bytes(),
+            "copy of {size_bytes} bytes outside {} or {}",
+            src.name(),
+            dst.name()
+        );
         let region = [vk::BufferCopy {
-            src_offset: 0,
-            dst_offset: 0,
+            src_offset,
+            dst_offset,
             size: size_bytes,
         }];
         // SAFETY: recording; sizes are within both buffers (callers check).
@@ -386,7 +405,7 @@ impl<'a> Recorder<'a> {
         Ok(())
     }
 
-    pub(crate) fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
+    pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
         let region = [vk::BufferImageCopy::default()
             .image_subresource(dst.subresource_layers())
             .image_extent(dst.vk_extent())];

@@ -30,6 +30,7 @@ const uint PIXELS = PER_AXIS * PER_AXIS;
 shared vec4 batch_reach[64];   // centre.xy, reach, 1 when the local scale applies
 shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shrink
 shared Fragment batch[64];
+shared uint unsaturated;       // threads with a pixel whose closed groups cover < 1 − ε
 
 // RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block).
 vec3 kernel_rgb(vec2 d, float l, float index) {
@@ -83,6 +84,9 @@ void main() {
     uint tx = tile % frame.tiles_x;
     uint ty = tile / frame.tiles_x;
     uint n = counts[tile];
+    if (!list_fits(offsets[tile], n)) {
+        return;
+    }
     uint base = offsets[tile] - frame.band_first_entry;
     uint local_index = gl_LocalInvocationIndex;
 
@@ -104,6 +108,9 @@ void main() {
     bool grouped = frame.blend_mode == 0u;
 
     for (uint start = 0u; start < n; start += 64u) {
+        if (local_index == 0u) {
+            unsaturated = 0u;
+        }
         if (start + local_index < n) {
             Fragment f = fragments[entries[base + start + local_index].y];
             batch[local_index] = f;
@@ -148,7 +155,22 @@ void main() {
                 }
             }
         }
+        // Early exit: once every pixel of the tile is covered to 1 − ε in every channel by
+        // closed groups (or by the per-fragment blend), what lies behind adds at most ε of its
+        // light; the open group is not closed yet and may still grow, so it does not count.
+        bool saturated = true;
+        for (uint q = 0u; q < PIXELS; q++) {
+            saturated = saturated && all(greaterThanEqual(A[q], vec3(1.0 - frame.saturation_epsilon)));
+        }
+        if (!saturated || frame.saturation_epsilon <= 0.0) {
+            atomicAdd(unsaturated, 1u);
+        }
         barrier();
+        bool done = unsaturated == 0u;
+        barrier();
+        if (done) {
+            break;
+        }
     }
 
     for (uint q = 0u; q < PIXELS; q++) {

@@ -30,7 +30,10 @@ void main() {
         for (int tx = tiles.x; tx <= tiles.z; tx++) {
             uint tile = uint(ty) * frame.tiles_x + uint(tx);
             uint slot = atomicAdd(cursors[tile], 1u);
-            entries[offsets[tile] - frame.band_first_entry + slot] = entry_key(f.depth, index);
+            uint at = offsets[tile] - frame.band_first_entry + slot;
+            if (at < frame.entry_capacity) {
+                entries[at] = entry_key(f.depth, index);
+            }
         }
     }
 }

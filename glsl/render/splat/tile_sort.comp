@@ -26,7 +26,7 @@ void main() {
         return; // whole workgroup: no barrier is skipped by some threads only
     }
     uint n = counts[tile];
-    if (n < 2u) {
+    if (n < 2u || !list_fits(offsets[tile], n)) {
         return;
     }
     uint base = offsets[tile] - frame.band_first_entry;

@@ -39,7 +39,8 @@ pub struct Fragment {
     pub dioptre: f32,
 }
 
-/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (112 bytes).
+/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (128 bytes, the
+/// smallest push-constant size every Vulkan device offers).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct FrameParams {
@@ -63,6 +64,9 @@ pub(crate) struct FrameParams {
     pub group_tolerance_d: f32,
     pub blend_mode: u32,
     pub wide_field: u32,
+    pub entry_capacity: u32,
+    pub saturation_epsilon: f32,
+    pub pad: [u32; 2],
     pub pass_u: [u32; 4],
     pub pass_f: [f32; 4],
 }
@@ -103,6 +107,9 @@ pub struct SplatSettings {
     pub max_list_bytes: u64,
     /// How fragments combine, and the wide-field geometry.
     pub blend: BlendSettings,
+    /// The convolution stops walking a tile's list once every pixel's coverage reaches
+    /// 1 − ε in every channel (0 = never): what lies behind then adds at most ε of its light.
+    pub saturation_epsilon: f32,
 }
 
 impl Default for SplatSettings {
@@ -113,9 +120,13 @@ impl Default for SplatSettings {
             merge: MergeSettings::default(),
             max_list_bytes: 1 << 30,
             blend: BlendSettings::default(),
+            saturation_epsilon: DEFAULT_SATURATION_EPSILON,
         }
     }
 }
+
+/// Default early-exit threshold of the convolution.
+pub const DEFAULT_SATURATION_EPSILON: f32 = 1e-3;
 
 impl SplatSettings {
     pub fn validate(&self) -> Result<(), String> {
@@ -136,6 +147,12 @@ impl SplatSettings {
             && self.merge.dioptre_tolerance >= 0.0)
         {
             return Err("merge thresholds must be non-negative numbers".into());
+        }
+        if !(self.saturation_epsilon.is_finite() && (0.0..0.5).contains(&self.saturation_epsilon)) {
+            return Err(format!(
+                "saturation epsilon {} is outside 0 to 0.5",
+                self.saturation_epsilon
+            ));
         }
         self.blend.validate()
     }
@@ -179,6 +196,12 @@ pub struct SplatStats {
     pub list_entries: u64,
     pub max_entries_per_tile: u64,
     pub bands: u32,
+    /// Queue submissions, GPU allocations and host↔device bytes this frame cost (the engine's
+    /// counters: a steady-state frame is one submission and no allocation).
+    pub submissions: u32,
+    pub allocations: u32,
+    pub upload_bytes: u64,
+    pub readback_bytes: u64,
 }
 
 /// Intermediate buffers of a single-band frame, read back for tests.
@@ -211,6 +234,12 @@ struct FrameResources {
     cursors: Buffer,
     offsets: Buffer,
     block_sums: Buffer,
+    /// Persistent, mapped transfer buffers: inputs in, the image and the list sizes out.
+    staging_color: Buffer,
+    staging_depth: Buffer,
+    readback_color: Buffer,
+    /// counts (tiles + 1, the last = live fragments), then offsets (tiles + 1, the last = total).
+    readback_lists: Buffer,
 }
 
 pub struct Splatter {
@@ -221,6 +250,13 @@ pub struct Splatter {
     texture: Image,
     sampler: Sampler,
     radii: Buffer,
+    radii_staging: Buffer,
+    /// The blend the PSF texture holds (None: not built yet).
+    texture_blend: Option<crate::psf::kernels::GridBlend>,
+    /// Lists of the last frame: total entries and bands (decides the one-submission path).
+    last_lists: Option<(u64, usize)>,
+    /// GPU allocations made so far (buffers and images of frame-size resources and lists).
+    allocations: u32,
     /// Per set, the core radius of every object's kernels (see `KernelSet::core_radii_px`).
     core_radii: Vec<Vec<[f32; 3]>>,
     frame: Option<FrameResources>,
@@ -273,6 +309,15 @@ impl Splatter {
             texture,
             sampler: Sampler::linear(ctx, Edge::ZeroBorder)?,
             radii,
+            radii_staging: Buffer::new(
+                ctx,
+                "object radii staging",
+                grid.objects.count as u64 * 16,
+                Residency::Upload,
+            )?,
+            texture_blend: None,
+            last_lists: None,
+            allocations: 0,
             core_radii: grid.sets.iter().map(|s| s.core_radii_px()).collect(),
             frame: None,
             entries: None,
@@ -364,7 +409,24 @@ impl Splatter {
                 tiles.div_ceil(1024) * 4,
                 Residency::Device,
             )?,
+            staging_color: Buffer::new(
+                ctx,
+                "input colour staging",
+                pixels * 16,
+                Residency::Upload,
+            )?,
+            staging_depth: Buffer::new(ctx, "input depth staging", pixels * 4, Residency::Upload)?,
+            readback_color: Buffer::new(ctx, "output read-back", pixels * 16, Residency::Readback)?,
+            readback_lists: Buffer::new(
+                ctx,
+                "list sizes read-back",
+                2 * (tiles + 1) * 4,
+                Residency::Readback,
+            )?,
         });
+        self.allocations += 13;
+        self.texture_blend = None;
+        self.last_lists = None;
         Ok(())
     }
 
@@ -394,6 +456,9 @@ impl Splatter {
                 BlendMode::PerFragment => 1,
             },
             wide_field: u32::from(self.settings.blend.wide_field),
+            entry_capacity: 0,
+            saturation_epsilon: self.settings.saturation_epsilon,
+            pad: [0; 2],
             pass_u: [0; 4],
             pass_f: [0.0; 4],
         }
@@ -427,11 +492,9 @@ impl Splatter {
                 view.pupil_mm, view.focus_d
             )));
         }
+        let allocations_before = self.allocations;
         self.ensure_frame(w, h)?;
         let ctx = self.ctx.clone();
-        let frame = self.frame.as_ref().expect("ensured above");
-        frame.color_in.upload(&ctx, input.color)?;
-        frame.depth_in.upload(&ctx, input.depth_m)?;
         let blend = self.grid.blend(view.pupil_mm, view.focus_d);
         // xyz: natural radius per channel; w: the smallest core radius over the channels,
         // which decides merging.
@@ -443,55 +506,104 @@ impl Splatter {
             .zip(&core)
             .map(|(r, k)| [r[0], r[1], r[2], k[0].min(k[1]).min(k[2])])
             .collect();
+        {
+            // Inputs go through persistent mapped buffers: no allocation per frame.
+            let frame = self.frame.as_mut().expect("ensured above");
+            write_mapped(&mut frame.staging_color, input.color);
+            write_mapped(&mut frame.staging_depth, input.depth_m);
+            write_mapped(&mut self.radii_staging, &radii);
+        }
+        let upload_bytes = (pixels * 20 + radii.len() * 16) as u64;
+        let frame = self.frame.as_ref().expect("ensured above");
         let mut params = self.params(frame);
         params.focal_px = input.projection().focal_px() as f32;
         let tiles = frame.tiles_x * frame.tiles_y;
+        let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
+        let output_bytes = pixels as u64 * 16;
 
-        // Submission 1: everything up to the exact list size.
-        let mut timings = ctx.submit(|rec| {
-            rec.upload_buffer(&self.radii, &radii)?;
-            rec.begin_pass("psf texture");
-            self.psf_texture
-                .record(rec, &params, &self.resident, &blend, &self.texture)?;
-            rec.begin_pass("fragments");
-            self.fragments_pass.record(
-                rec,
-                &params,
-                &frame.color_in,
-                &frame.depth_in,
-                &self.radii,
-                &frame.fragments,
-            )?;
-            if self.settings.merge.levels > 0 {
-                rec.begin_pass("merge");
-                self.merge.record(
-                    rec,
-                    &params,
-                    self.settings.merge.levels,
-                    &self.radii,
-                    &frame.fragments,
-                )?;
+        // Steady state: the whole frame in one submission, with the list buffer of earlier
+        // frames; only the list total comes back, and a frame whose lists outgrew the buffer
+        // (or need bands) is rendered again below, in bands.
+        let one_submission = !keep_intermediates
+            && self.entries.is_some()
+            && self.last_lists.is_some_and(|(_, bands)| bands == 1);
+        let mut submissions = 0u32;
+        if one_submission {
+            let entries = self.entries.as_ref().expect("checked above");
+            let mut p = params;
+            p.entry_capacity = entries_in(entries);
+            let timings = ctx.submit(|rec| {
+                self.record_front(rec, frame, &p, &blend, rebuild_texture)?;
+                rec.copy_buffer_region(
+                    &frame.counts,
+                    u64::from(tiles) * 4,
+                    &frame.readback_lists,
+                    u64::from(tiles) * 4,
+                    4,
+                );
+                rec.copy_buffer_region(
+                    &frame.offsets,
+                    u64::from(tiles) * 4,
+                    &frame.readback_lists,
+                    u64::from(2 * tiles + 1) * 4,
+                    4,
+                );
+                self.record_band(rec, frame, &p, entries, tiles)?;
+                rec.end_pass();
+                rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
+                Ok(())
+            })?;
+            submissions += 1;
+            let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
+            let (live, total) = (sizes[tiles as usize], sizes[2 * tiles as usize + 1]);
+            if u64::from(total) <= u64::from(p.entry_capacity) {
+                self.texture_blend = Some(blend);
+                self.last_lists = Some((u64::from(total), 1));
+                let stats = SplatStats {
+                    fragments: pixels as u64,
+                    live_fragments: u64::from(live),
+                    list_entries: u64::from(total),
+                    max_entries_per_tile: 0,
+                    bands: 1,
+                    submissions,
+                    allocations: self.allocations - allocations_before,
+                    upload_bytes,
+                    readback_bytes: output_bytes + 8,
+                };
+                return Ok(SplatOutput {
+                    color: read_mapped(&frame.readback_color),
+                    timings: merge_repeated(timings),
+                    stats,
+                    intermediates: None,
+                });
             }
-            rec.begin_pass("tile count");
-            rec.fill_buffer(&frame.counts, 0);
-            self.tile_count
-                .record(rec, &params, &frame.fragments, &frame.counts)?;
-            rec.begin_pass("prefix sum");
-            self.prefix_sum.record(
-                rec,
-                &params,
-                tiles,
-                &frame.counts,
-                &frame.offsets,
-                &frame.block_sums,
-            )?;
+        }
+
+        // Planning frame: everything up to the exact list sizes, read back to plan bands.
+        let mut timings = ctx.submit(|rec| {
+            self.record_front(rec, frame, &params, &blend, true)?;
             rec.end_pass();
+            rec.copy_buffer_region(
+                &frame.counts,
+                0,
+                &frame.readback_lists,
+                0,
+                u64::from(tiles + 1) * 4,
+            );
+            rec.copy_buffer_region(
+                &frame.offsets,
+                0,
+                &frame.readback_lists,
+                u64::from(tiles + 1) * 4,
+                u64::from(tiles + 1) * 4,
+            );
             Ok(())
         })?;
-        // The counts buffer ends with the number of live (not merged-away) fragments.
-        let counts_and_live: Vec<u32> = frame.counts.read(&ctx)?;
-        let offsets: Vec<u32> = frame.offsets.read(&ctx)?;
-        let counts = &counts_and_live[..tiles as usize];
+        submissions += 1;
+        let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
+        let counts = sizes[..tiles as usize].to_vec();
+        let live = u64::from(sizes[tiles as usize]);
+        let offsets = sizes[tiles as usize + 1..].to_vec();
         let total: u64 = counts.iter().map(|&c| u64::from(c)).sum();
         if total != u64::from(offsets[tiles as usize]) {
             return Err(GpuError::Usage {
@@ -503,9 +615,7 @@ impl Splatter {
             }
             .into());
         }
-        let bands = plan_bands(counts, frame.tiles_x, self.list_capacity_entries())?;
-
-        // Submission 2: lists, sorting and convolution, band by band.
+        let bands = plan_bands(&counts, frame.tiles_x, self.list_capacity_entries())?;
         let largest_band = bands.iter().map(|b| b.entries).max().unwrap_or(0);
         self.ensure_entries(largest_band)?;
         let frame = self.frame.as_ref().expect("ensured above");
@@ -516,51 +626,28 @@ impl Splatter {
                 p.band_first_tile = band.first_tile;
                 p.band_end_tile = band.end_tile;
                 p.band_first_entry = band.first_entry;
-                rec.begin_pass("tile fill");
-                rec.fill_buffer(&frame.cursors, 0);
-                self.tile_fill.record(
-                    rec,
-                    &p,
-                    &frame.fragments,
-                    &frame.offsets,
-                    &frame.cursors,
-                    entries,
-                )?;
-                rec.begin_pass("tile sort");
-                self.tile_sort.record(
-                    rec,
-                    &p,
-                    band.end_tile - band.first_tile,
-                    &frame.counts,
-                    &frame.offsets,
-                    entries,
-                )?;
-                rec.begin_pass("convolve");
-                self.convolve.record(
-                    rec,
-                    &p,
-                    band.end_tile - band.first_tile,
-                    (&self.texture, &self.sampler),
-                    &frame.fragments,
-                    &frame.counts,
-                    &frame.offsets,
-                    entries,
-                    &frame.color_out,
-                )?;
+                p.entry_capacity = entries_in(entries);
+                self.record_band(rec, frame, &p, entries, band.end_tile - band.first_tile)?;
             }
             rec.end_pass();
+            rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
             Ok(())
         })?;
+        submissions += 1;
         timings.extend(band_timings);
-        let color: Vec<[f32; 4]> = frame.color_out.read(&ctx)?;
-
-        let live = u64::from(counts_and_live[tiles as usize]);
+        self.texture_blend = Some(blend);
+        self.last_lists = Some((total, bands.len()));
+        let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
         let stats = SplatStats {
             fragments: pixels as u64,
             live_fragments: live,
             list_entries: total,
             max_entries_per_tile: counts.iter().copied().max().unwrap_or(0).into(),
             bands: bands.len() as u32,
+            submissions,
+            allocations: self.allocations - allocations_before,
+            upload_bytes,
+            readback_bytes: output_bytes + u64::from(2 * (tiles + 1)) * 4,
         };
         let intermediates = if keep_intermediates {
             let mut all_entries: Vec<[u32; 2]> = entries.read(&ctx)?;
@@ -568,8 +655,8 @@ impl Splatter {
             let fragments: Vec<Fragment> = frame.fragments.read(&ctx)?;
             Some(SplatIntermediates {
                 fragments,
-                counts: counts.to_vec(),
-                offsets: offsets.to_vec(),
+                counts,
+                offsets,
                 entries: all_entries,
             })
         } else {
@@ -581,6 +668,103 @@ impl Splatter {
             stats,
             intermediates,
         })
+    }
+
+    /// Records the passes before the lists: inputs, PSF texture (when the blend changed),
+    /// fragments, merging, tile counts and their prefix sum.
+    fn record_front(
+        &self,
+        rec: &mut crate::gpu::Recorder<'_>,
+        frame: &FrameResources,
+        params: &FrameParams,
+        blend: &crate::psf::kernels::GridBlend,
+        rebuild_texture: bool,
+    ) -> crate::gpu::GpuResult<()> {
+        rec.begin_pass("upload");
+        rec.copy_buffer_to_image(&frame.staging_color, &frame.color_in);
+        rec.copy_buffer_to_image(&frame.staging_depth, &frame.depth_in);
+        rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
+        if rebuild_texture {
+            rec.begin_pass("psf texture");
+            self.psf_texture
+                .record(rec, params, &self.resident, blend, &self.texture)?;
+        }
+        rec.begin_pass("fragments");
+        self.fragments_pass.record(
+            rec,
+            params,
+            &frame.color_in,
+            &frame.depth_in,
+            &self.radii,
+            &frame.fragments,
+        )?;
+        if self.settings.merge.levels > 0 {
+            rec.begin_pass("merge");
+            self.merge.record(
+                rec,
+                params,
+                self.settings.merge.levels,
+                &self.radii,
+                &frame.fragments,
+            )?;
+        }
+        rec.begin_pass("tile count");
+        rec.fill_buffer(&frame.counts, 0);
+        self.tile_count
+            .record(rec, params, &frame.fragments, &frame.counts)?;
+        rec.begin_pass("prefix sum");
+        self.prefix_sum.record(
+            rec,
+            params,
+            frame.tiles_x * frame.tiles_y,
+            &frame.counts,
+            &frame.offsets,
+            &frame.block_sums,
+        )?;
+        Ok(())
+    }
+
+    /// Records one band's list fill, sort and convolution.
+    fn record_band(
+        &self,
+        rec: &mut crate::gpu::Recorder<'_>,
+        frame: &FrameResources,
+        params: &FrameParams,
+        entries: &Buffer,
+        band_tiles: u32,
+    ) -> crate::gpu::GpuResult<()> {
+        rec.begin_pass("tile fill");
+        rec.fill_buffer(&frame.cursors, 0);
+        self.tile_fill.record(
+            rec,
+            params,
+            &frame.fragments,
+            &frame.offsets,
+            &frame.cursors,
+            entries,
+        )?;
+        rec.begin_pass("tile sort");
+        self.tile_sort.record(
+            rec,
+            params,
+            band_tiles,
+            &frame.counts,
+            &frame.offsets,
+            entries,
+        )?;
+        rec.begin_pass("convolve");
+        self.convolve.record(
+            rec,
+            params,
+            band_tiles,
+            (&self.texture, &self.sampler),
+            &frame.fragments,
+            &frame.counts,
+            &frame.offsets,
+            entries,
+            &frame.color_out,
+        )?;
+        Ok(())
     }
 
     /// Entries one band may hold: the binding limit, the memory budget, and a test override.
@@ -602,6 +786,7 @@ impl Splatter {
             .min(self.list_capacity_entries() * ENTRY_BYTES)
             .max(needed);
         self.entries = None;
+        self.allocations += 1;
         self.entries = Some(Buffer::new(
             &self.ctx,
             "tile lists",
@@ -662,6 +847,29 @@ pub(crate) fn plan_bands(counts: &[u32], tiles_x: u32, capacity: u64) -> crate::
         entries,
     });
     Ok(bands)
+}
+
+/// Entries a list buffer holds.
+fn entries_in(entries: &Buffer) -> u32 {
+    (entries.size_bytes() / ENTRY_BYTES).min(u64::from(u32::MAX)) as u32
+}
+
+/// Copies `data` into a host-visible buffer through its mapping.
+fn write_mapped<T: bytemuck::Pod>(buffer: &mut Buffer, data: &[T]) {
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    buffer
+        .mapped_bytes_mut()
+        .expect("upload buffers are host-visible")[..bytes.len()]
+        .copy_from_slice(bytes);
+}
+
+/// The contents of a host-visible read-back buffer.
+fn read_mapped<T: bytemuck::Pod>(buffer: &Buffer) -> Vec<T> {
+    let bytes = buffer
+        .mapped_bytes()
+        .expect("read-back buffers are host-visible");
+    let n = bytes.len() / std::mem::size_of::<T>();
+    bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<T>()])
 }
 
 /// Sums the timings of passes that ran once per band, keeping first-seen order.
