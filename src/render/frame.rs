@@ -13,7 +13,7 @@ use crate::psf::exact::ExactEye;
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::KernelGrid;
 use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
-use crate::render::reference::dioptre_of_depth;
+use crate::render::focus::vergence_of_depth_d;
 use crate::render::splat::{FrameInput, SplatSettings, SplatStats, Splatter, ViewState};
 use crate::render::{reference, slices};
 use crate::{Error, Result};
@@ -84,7 +84,7 @@ pub struct PreparedKernels {
 pub fn dioptre_range(depth_m: &[f32]) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for &d in depth_m {
-        let v = dioptre_of_depth(d);
+        let v = vergence_of_depth_d(d);
         lo = lo.min(v);
         hi = hi.max(v);
     }

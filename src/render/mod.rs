@@ -1,6 +1,7 @@
 //! Rendering: joins scenes, the eye's kernels (`psf`) and the GPU layer (`gpu`). Each GPU pass
 //! is one Rust file plus GLSL files of the same stem under glsl/render/.
 
+pub mod focus;
 pub mod frame;
 pub mod raster;
 pub mod reference;
