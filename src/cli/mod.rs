@@ -129,8 +129,8 @@ pub(crate) fn measured_scene_frame(
 )> {
     let state = scene.at_time(0.0);
     let frame = crate::render::Rasterizer::new(ctx)?.render(ctx, &state, width, height)?;
-    let focus_d = if state.focus_m.is_finite() && state.focus_m > 0.0 {
-        1.0 / state.focus_m
+    let focus_d = if state.focus_m > 0.0 {
+        crate::render::focus::focus_d_of_distance_m(state.focus_m)
     } else {
         0.0
     };

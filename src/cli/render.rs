@@ -241,15 +241,15 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
     let frame = rasterizer.render(ctx, &state, width, height)?;
     let mut depth_m = frame.depth_m;
     let mut warnings = Vec::new();
-    let near = crate::render::focus::NEAREST_SUPPORTED_M;
+    let near = crate::render::focus::nearest_supported_m();
     let clamped = depth_m.iter_mut().filter(|d| **d > 0.0 && **d < near).fold(0, |n, d| {
         *d = near;
         n + 1
     });
     if clamped > 0 {
         warnings.push(format!(
-            "scene {name}: {clamped} pixel(s) nearer than {near} m were clamped to {near} m (the \
-             nearest distance ocular renders, 50 D)"
+            "scene {name}: {}",
+            crate::inputs::depth::near_clamp_warning(clamped)
         ));
     }
     Ok(Input {
@@ -441,6 +441,14 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let (focus_d, focus_from) = focus_dioptres(args, &input)?;
+    if focus_d > crate::render::focus::MAX_OBJECT_VERGENCE_D {
+        return Err(Error::input(format!(
+            "{focus_from}: a focus at {:.4} m ({focus_d:.1} D) is nearer than ocular renders \
+             (at most {} D, 2 cm)",
+            1.0 / focus_d,
+            crate::render::focus::MAX_OBJECT_VERGENCE_D
+        )));
+    }
     let (pupil_mm, pupil_source) = pupil_diameter(args, &input)?;
     let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let focus = crate::render::focus::effective_focus(

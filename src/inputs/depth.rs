@@ -6,12 +6,12 @@
 //!   half-float channel (the largest half, Eevee's background).
 //! - Invalid values — NaN, −∞, negative — are far as well, but counted and reported with the
 //!   first such pixel, since they usually mean a broken file or the wrong channel.
-//! - After `--depth-scale`, depths nearer than [`NEAREST_SUPPORTED_M`] are clamped to it, with
-//!   one warning giving their count: the kernels cover object vergences up to 50 D.
+//! - After `--depth-scale`, depths nearer than [`nearest_supported_m`] (about 2 cm) are clamped
+//!   to it, with one warning giving their count: the kernels cover vergences up to about 50 D.
 //! - A depth map with a single value everywhere (Blender's "Z = 1" compositor trap) is
 //!   accepted with a warning.
 
-use crate::render::focus::NEAREST_SUPPORTED_M;
+use crate::render::focus::nearest_supported_m;
 
 /// Raw values from this far on mark the background (scene units, before `--depth-scale`).
 pub const BACKGROUND_FROM: f32 = 1e9;
@@ -47,11 +47,7 @@ impl DepthReport {
             ));
         }
         if self.clamped_near_px > 0 {
-            out.push(format!(
-                "{} pixel(s) nearer than {} m were clamped to {} m (the nearest distance ocular \
-                 renders, 50 D)",
-                self.clamped_near_px, NEAREST_SUPPORTED_M, NEAREST_SUPPORTED_M
-            ));
+            out.push(near_clamp_warning(self.clamped_near_px));
         }
         if let Some(d) = self.constant_m {
             out.push(format!(
@@ -63,11 +59,21 @@ impl DepthReport {
     }
 }
 
+/// The warning for `count` depths clamped to the nearest supported distance.
+pub fn near_clamp_warning(count: usize) -> String {
+    let near = nearest_supported_m();
+    format!(
+        "{count} pixel(s) nearer than {near:.4} m were clamped to it (the nearest distance ocular \
+         renders, {:.3} D)",
+        1.0 / f64::from(near)
+    )
+}
+
 /// Applies the policy to raw depth values of a `width`-wide map: background and invalid values
 /// become +∞, the rest are scaled to metres by `scale` and clamped at the near limit.
 pub fn apply(raw: &[f32], width: u32, half: bool, scale: f64) -> (Vec<f32>, DepthReport) {
     let mut report = DepthReport::default();
-    let near = NEAREST_SUPPORTED_M;
+    let near = nearest_supported_m();
     let mut first: Option<f32> = None;
     let mut constant = true;
     let mut finite = 0usize;

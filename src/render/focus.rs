@@ -5,14 +5,26 @@ use crate::eye::accommodate::accommodate;
 use crate::eye::measure::Measurer;
 use crate::eye::Eye;
 use crate::optics::zernike::osa_index;
-use crate::psf::axes::KernelSettings;
+use crate::psf::axes::{GridAxes, KernelSettings};
 use crate::{Error, Result};
 
 /// The largest object vergence the kernels cover (the planner's limit), in dioptres.
 pub const MAX_OBJECT_VERGENCE_D: f64 = 50.0;
 
-/// The nearest depth ocular renders (1/50 D = 2 cm); file depths nearer are clamped to it.
-pub const NEAREST_SUPPORTED_M: f32 = 0.02;
+/// The nearest depth ocular renders, in metres (about 2 cm): the reciprocal of the largest
+/// object vergence on the reference grid's spacing within [`MAX_OBJECT_VERGENCE_D`], since the
+/// planner brackets a scene's range with grid points. Depths nearer are clamped to it; it is
+/// rounded up in f32 so that its vergence never exceeds that grid point.
+pub fn nearest_supported_m() -> f32 {
+    let o = GridAxes::default().objects;
+    let top_d = o.min_d + o.step_d * ((MAX_OBJECT_VERGENCE_D - o.min_d) / o.step_d + 1e-9).floor();
+    let m = (1.0 / top_d) as f32;
+    if 1.0 / f64::from(m) > top_d {
+        m.next_up()
+    } else {
+        m
+    }
+}
 
 /// Focus distances from this far on are infinity: the vergence (≤ 1e-4 D) is far below any
 /// eye's depth of field, and accommodating to it numerically is ill-posed.
