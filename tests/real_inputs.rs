@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 
 use common::blender::{
     combined, cycles_layer, depth_values, half_plane, plane, write_multi_part, write_single_part,
+    write_views,
 };
 use ocular::inputs::{self, FileInputOptions};
 
@@ -157,6 +158,36 @@ fn several_layers_need_a_choice_and_the_choice_picks_its_own_depth() {
     o.color_layer = Some("NoSuchLayer".into());
     let (_, text) = error_of(&o);
     assert!(text.contains("NoSuchLayer") && text.contains("ViewLayer.Combined"), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn stereo_views_need_a_choice_and_depth_follows_the_view() {
+    let dir = temp_dir("views");
+    let path = dir.join("stereo.exr");
+    let view = |base: f32, near: f32| {
+        let mut planes: Vec<_> = combined("ViewLayer", SIZE, base);
+        planes.push(plane("ViewLayer.Depth.Z", depth_values(SIZE, near, 1e10)));
+        planes
+    };
+    write_views(
+        &path,
+        SIZE,
+        vec![("left", "left", view(1.0, 2.0)), ("right", "right", view(5.0, 3.0))],
+    );
+    let (code, text) = error_of(&options(&path));
+    assert_eq!(code, 2);
+    assert!(
+        text.contains("left.ViewLayer.Combined")
+            && text.contains("right.ViewLayer.Combined")
+            && text.contains("--color-layer"),
+        "{text}"
+    );
+    let mut o = options(&path);
+    o.color_layer = Some("right.ViewLayer.Combined".into());
+    let got = inputs::load(&o).unwrap();
+    assert_eq!(got.color.pixels[0][1], 10.0);
+    assert_eq!(got.depth_m[16], 3.25, "the right view's depth");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

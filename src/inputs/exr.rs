@@ -44,6 +44,8 @@ pub struct Channel {
     pub pass: String,
     /// The group's first component when it has a pass below it (`ViewLayer`), else "".
     pub layer: String,
+    /// The view (`left`, `right`) of a multi-view file, else "".
+    pub view: String,
     /// Stored as 16-bit floats (background may then read 65504, the largest half).
     pub half: bool,
     pub width: u32,
@@ -73,15 +75,18 @@ fn exr_error(path: &Path, error: exr::error::Error) -> Error {
     }
 }
 
-/// Splits a group name into (layer, pass), dropping a trailing view component.
-fn layer_and_pass(group: &str, views: &[String]) -> (String, String) {
-    let mut parts: Vec<&str> = if group.is_empty() {
-        Vec::new()
-    } else {
-        group.split('.').collect()
-    };
-    if parts.len() > 1 && views.iter().any(|v| v == parts[parts.len() - 1]) {
-        parts.pop();
+/// Splits a group name into (layer, pass, view): a component naming one of the file's views
+/// is the view wherever it stands (OpenEXR puts it before the channel, multi-part files may put
+/// it in the part name), the last other component is the pass and the first the layer.
+fn layer_pass_view(group: &str, views: &[String]) -> (String, String, String) {
+    let mut view = String::new();
+    let mut parts: Vec<&str> = Vec::new();
+    for p in group.split('.').filter(|p| !p.is_empty()) {
+        if view.is_empty() && views.iter().any(|v| v == p) {
+            view = p.to_string();
+        } else {
+            parts.push(p);
+        }
     }
     let pass = parts.last().map_or(String::new(), |p| p.to_string());
     let layer = if parts.len() > 1 {
@@ -89,7 +94,7 @@ fn layer_and_pass(group: &str, views: &[String]) -> (String, String) {
     } else {
         String::new()
     };
-    (layer, pass)
+    (layer, pass, view)
 }
 
 impl ExrChannels {
@@ -155,7 +160,7 @@ impl ExrChannels {
                         format!("channel {own} is subsampled; ocular needs full resolution"),
                     ));
                 }
-                let (layer_name, pass) = layer_and_pass(&group, &views);
+                let (layer_name, pass, view_name) = layer_pass_view(&group, &views);
                 let full_name = if group.is_empty() {
                     channel.clone()
                 } else {
@@ -167,6 +172,7 @@ impl ExrChannels {
                     channel,
                     pass,
                     layer: layer_name,
+                    view: view_name,
                     half: matches!(c.sample_data, FlatSamples::F16(_)),
                     width: width as u32,
                     height: height as u32,
@@ -334,14 +340,15 @@ impl ExrChannels {
 
     /// The depth channel: the one named by `channel` (a full name, or a group holding one
     /// channel), else the `Depth` pass (`<layer>.Depth.Z`, `Depth.V`) or a bare `Z`/`depth`
-    /// channel — preferring `prefer_layer` when several layers have one — else the only channel
+    /// channel — preferring the (layer, view) of `prefer` (the colour's) when several layers
+    /// or views have one — else the only channel
     /// of a one-channel file. Denoising, Mist, Normal and similar passes are never guessed.
     /// Returns the channel and every automatic candidate.
     pub fn depth(
         &self,
         path: &Path,
         channel: Option<&str>,
-        prefer_layer: Option<&str>,
+        prefer: Option<(&str, &str)>,
     ) -> Result<(&Channel, Vec<String>)> {
         if let Some(want) = channel {
             let exact: Vec<&Channel> = self
@@ -388,8 +395,11 @@ impl ExrChannels {
             [one] => return Ok((one, names)),
             [] => {}
             many => {
-                if let Some(layer) = prefer_layer {
-                    let same: Vec<&&Channel> = many.iter().filter(|c| c.layer == layer).collect();
+                if let Some((layer, view)) = prefer {
+                    let same: Vec<&&Channel> = many
+                        .iter()
+                        .filter(|c| c.layer == layer && c.view == view)
+                        .collect();
                     if let [one] = same.as_slice() {
                         return Ok((one, names));
                     }

@@ -105,7 +105,7 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
                 .channels
                 .iter()
                 .find(|c| c.group == group)
-                .map(|c| c.layer.clone());
+                .map(|c| (c.layer.clone(), c.view.clone()));
             let label = if group.is_empty() {
                 options.color.display().to_string()
             } else {
@@ -154,7 +154,7 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
     let (channel, candidates) = depth_file.depth(
         depth_path,
         options.depth_channel.as_deref(),
-        color_layer.as_deref(),
+        color_layer.as_ref().map(|(l, v)| (l.as_str(), v.as_str())),
     )?;
     let raw = exr::RawDepth::from_channel(channel, candidates);
     if (color.width, color.height) != (raw.image.width, raw.image.height) {

@@ -75,6 +75,22 @@ pub fn write_multi_part(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, V
         .unwrap();
 }
 
+/// A stereo multi-part file: one part per (name, view), the `view` attribute set.
+pub fn write_views(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, &str, Vec<Plane>)>) {
+    let layers: Vec<Layer<AnyChannels<FlatSamples>>> = parts
+        .into_iter()
+        .map(|(name, view, planes)| {
+            let mut attributes = LayerAttributes::named(name);
+            attributes.view_name = Some(Text::from(view));
+            Layer::new((w, h), attributes, Encoding::FAST_LOSSLESS, channels(planes))
+        })
+        .collect();
+    Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))), layers)
+        .write()
+        .to_file(path)
+        .unwrap();
+}
+
 /// `<layer>.Combined.{R,G,B,A}` with distinct, recognisable values: R = `base` + x, G = 2·base,
 /// B = 3·base, A = 1.
 pub fn combined(layer: &str, (w, h): (usize, usize), base: f32) -> Vec<Plane> {
