@@ -402,8 +402,24 @@ fn pictures_are_decoded_from_srgb_and_scaled_to_white() {
     let (code, text) = error_of(&options(&png));
     assert_eq!(code, 2);
     assert!(text.contains("--depth") || text.contains("depth must be an EXR"), "{text}");
-    let mut o = options(&depth);
+    // EXR colour is cd/m² unless --white-cdm2 says what 1.0 is (Blender's scene-linear
+    // values are relative).
+    let exr = dir.join("c.exr");
+    write_single_part(
+        &exr,
+        (4, 2),
+        vec![
+            plane("R", vec![0.5; 8]),
+            plane("G", vec![0.25; 8]),
+            plane("B", vec![1.0; 8]),
+            plane("Z", vec![3.0; 8]),
+        ],
+    );
+    let mut o = options(&exr);
+    assert_eq!(inputs::load(&o).unwrap().color.pixels[0], [0.5, 0.25, 1.0, 1.0]);
     o.white_cdm2 = Some(100.0);
+    assert_eq!(inputs::load(&o).unwrap().color.pixels[0], [50.0, 25.0, 100.0, 1.0]);
+    o.white_cdm2 = Some(-1.0);
     assert!(error_of(&o).1.contains("--white-cdm2"));
     let mut o = options(&dir.join("c.bmp"));
     o.depth = Some(depth.clone());

@@ -64,8 +64,8 @@ pub struct RenderArgs {
     /// Metres per scene unit of the depth file (Blender: Scene > Units > Unit Scale).
     #[arg(long, value_name = "M", default_value_t = 1.0, allow_negative_numbers = true)]
     pub depth_scale: f64,
-    /// Luminance of white in cd/m² for PNG/JPEG/TIFF colour (default 80, the sRGB reference
-    /// display).
+    /// Luminance of white in cd/m²: of sRGB white in PNG/JPEG/TIFF colour (default 80, the sRGB
+    /// reference display), of 1.0 in EXR colour (default: EXR values are cd/m² already).
     #[arg(long, value_name = "CD/M2", requires = "color", allow_negative_numbers = true)]
     pub white_cdm2: Option<f64>,
     /// Render NaN or infinite colour samples of --color as black instead of refusing the file.

@@ -23,7 +23,8 @@ pub struct FileInputOptions {
     pub depth_channel: Option<String>,
     /// Scene units → metres.
     pub depth_scale: f64,
-    /// Luminance of white for sRGB pictures (None: [`picture::DEFAULT_WHITE_CDM2`]).
+    /// Luminance (cd/m²) of white: of sRGB white in pictures (None:
+    /// [`picture::DEFAULT_WHITE_CDM2`]), of 1.0 in EXR colour (None: EXR values are cd/m²).
     pub white_cdm2: Option<f64>,
     /// Replace non-finite colour samples by 0 instead of refusing the file.
     pub repair_nonfinite: bool,
@@ -76,12 +77,6 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
     }
     let color_kind = kind_of(&options.color, "--color")?;
     if let Some(white) = options.white_cdm2 {
-        if color_kind != Kind::Picture {
-            return Err(Error::input(
-                "--white-cdm2 applies to PNG, JPEG and TIFF colour; EXR colour is already \
-                 linear (in cd/m²)",
-            ));
-        }
         if !(white.is_finite() && white > 0.0 && white <= 1e6) {
             return Err(Error::input(format!(
                 "--white-cdm2 {white} must be a luminance in (0, 1e6] cd/m²"
@@ -100,16 +95,32 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
     };
     let (mut color, color_source, color_layer) = match &color_exr {
         Some(file) => {
-            let (image, group) = file.color(&options.color, options.color_layer.as_deref())?;
+            let (mut image, group) =
+                file.color(&options.color, options.color_layer.as_deref())?;
+            if let Some(white) = options.white_cdm2 {
+                let k = white as f32;
+                for p in &mut image.pixels {
+                    for v in &mut p[..3] {
+                        *v *= k;
+                    }
+                }
+            }
             let layer = file
                 .channels
                 .iter()
                 .find(|c| c.group == group)
                 .map(|c| (c.layer.clone(), c.view.clone()));
-            let label = if group.is_empty() {
+            let mut notes: Vec<String> = Vec::new();
+            if !group.is_empty() {
+                notes.push(group.clone());
+            }
+            if let Some(white) = options.white_cdm2 {
+                notes.push(format!("1.0 = {white} cd/m²"));
+            }
+            let label = if notes.is_empty() {
                 options.color.display().to_string()
             } else {
-                format!("{} ({group})", options.color.display())
+                format!("{} ({})", options.color.display(), notes.join(", "))
             };
             (image, label, layer)
         }
