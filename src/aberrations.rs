@@ -291,15 +291,12 @@ impl ZernikeSet {
                 ))
             })?;
             let k = k.trim();
-            let val: f64 = v
-                .trim()
-                .parse()
-                .map_err(|_| {
-                    err(format!(
-                        "value {:?} is not a number (a number may be followed by a # comment)",
-                        v.trim()
-                    ))
-                })?;
+            let val: f64 = v.trim().parse().map_err(|_| {
+                err(format!(
+                    "value {:?} is not a number (a number may be followed by a # comment)",
+                    v.trim()
+                ))
+            })?;
             if k.eq_ignore_ascii_case("ap") {
                 pupil = Some(val);
             } else if k.eq_ignore_ascii_case("wa") {

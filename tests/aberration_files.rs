@@ -158,7 +158,10 @@ fn inline_comments_and_blank_lines_are_ignored() {
     let e = ZernikeSet::from_csv_str("4, 0.5\n5 # no value\n", "w.csv", Some(5.0), Some(600.0))
         .unwrap_err()
         .to_string();
-    assert!(e.starts_with("w.csv:2:") && e.contains("j,coefficient_um"), "{e}");
+    assert!(
+        e.starts_with("w.csv:2:") && e.contains("j,coefficient_um"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -80,14 +80,27 @@ fn a_blender_multilayer_file_renders_with_its_combined_colour_and_depth() {
     // Defect 3: --focus-at on the background pixel (0, 0) focuses at infinity.
     let o = render(
         &[
-            "--color", p(&cycles), "--fov-y", "30", "--eye", "navarro", "--focus-at", "0,0",
+            "--color",
+            p(&cycles),
+            "--fov-y",
+            "30",
+            "--eye",
+            "navarro",
+            "--focus-at",
+            "0,0",
             "--json",
         ],
         &out,
     );
     let s = json_ok(&o);
-    assert!(s["input"].as_str().unwrap().contains("ViewLayer.Combined"), "{s}");
-    assert!(s["depth"].as_str().unwrap().contains("ViewLayer.Depth.Z"), "{s}");
+    assert!(
+        s["input"].as_str().unwrap().contains("ViewLayer.Combined"),
+        "{s}"
+    );
+    assert!(
+        s["depth"].as_str().unwrap().contains("ViewLayer.Depth.Z"),
+        "{s}"
+    );
     assert_eq!(s["focus_d"], 0.0);
     assert!(stderr(&o).is_empty(), "{}", stderr(&o));
     let image = ocular::image_io::read_exr_rgba(&out).unwrap();
@@ -97,13 +110,23 @@ fn a_blender_multilayer_file_renders_with_its_combined_colour_and_depth() {
     // --focus-at on a real pixel uses its Depth.Z (2 + 0.25·row), not the denoising depth.
     let o = render(
         &[
-            "--color", p(&cycles), "--fov-y", "30", "--eye", "navarro", "--focus-at", "3,4",
+            "--color",
+            p(&cycles),
+            "--fov-y",
+            "30",
+            "--eye",
+            "navarro",
+            "--focus-at",
+            "3,4",
             "--json",
         ],
         &out,
     );
     let s = json_ok(&o);
-    assert!((s["focus_d"].as_f64().unwrap() - 1.0 / 3.0).abs() < 1e-6, "{s}");
+    assert!(
+        (s["focus_d"].as_f64().unwrap() - 1.0 / 3.0).abs() < 1e-6,
+        "{s}"
+    );
 
     // With the compositor's layer too: refused, listing both, until one is chosen.
     let both = dir.join("composite.exr");
@@ -119,8 +142,17 @@ fn a_blender_multilayer_file_renders_with_its_combined_colour_and_depth() {
     );
     let o = render(
         &[
-            "--color", p(&both), "--fov-y", "30", "--color-layer", "Composite", "--eye",
-            "navarro", "--focus-m", "2", "--json",
+            "--color",
+            p(&both),
+            "--fov-y",
+            "30",
+            "--color-layer",
+            "Composite",
+            "--eye",
+            "navarro",
+            "--focus-m",
+            "2",
+            "--json",
         ],
         &out,
     );
@@ -167,11 +199,7 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
         assert_eq!(s["focus_d"], 0.0, "{extra:?}");
         // Defect 4: the 1 cm pixel is clamped with one warning that counts it.
         let text = stderr(&o);
-        assert_eq!(
-            text.matches("warning:").count(),
-            1,
-            "{extra:?}: {text}"
-        );
+        assert_eq!(text.matches("warning:").count(), 1, "{extra:?}: {text}");
         assert!(
             text.contains("1 pixel(s) nearer than 0.0201 m") && text.contains("d.exr"),
             "{text}"
@@ -183,7 +211,16 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
     let flat = dir.join("flat.exr");
     write_single_part(&flat, SIZE, vec![plane("Z", vec![1.0; N])]);
     let o = render(
-        &["--color", p(&colour), "--depth", p(&flat), "--fov-y", "40", "--focus-m", "1"],
+        &[
+            "--color",
+            p(&colour),
+            "--depth",
+            p(&flat),
+            "--fov-y",
+            "40",
+            "--focus-m",
+            "1",
+        ],
         &out,
     );
     assert!(o.status.success(), "{}", stderr(&o));
@@ -194,7 +231,14 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
     write_single_part(&cm, SIZE, vec![plane("Z", vec![250.0; N])]);
     let o = render(
         &[
-            "--color", p(&colour), "--depth", p(&cm), "--fov-y", "40", "--depth-scale", "0.01",
+            "--color",
+            p(&colour),
+            "--depth",
+            p(&cm),
+            "--fov-y",
+            "40",
+            "--depth-scale",
+            "0.01",
             "--json",
         ],
         &out,
@@ -226,7 +270,14 @@ fn focus_beyond_the_far_point_is_reported_where_the_eye_focuses() {
     let far_point_d = -ocular::eye::paraxial(&sys, 549.0, 0.0).refraction_d;
     assert!(far_point_d > 5.0, "{far_point_d}");
     let args = [
-        "--color", p(&colour), "--fov-y", "40", "--eye", "myopia", "--focus-m", "5",
+        "--color",
+        p(&colour),
+        "--fov-y",
+        "40",
+        "--eye",
+        "myopia",
+        "--focus-m",
+        "5",
     ];
     let mut with_json = args.to_vec();
     with_json.push("--json");
@@ -235,7 +286,10 @@ fn focus_beyond_the_far_point_is_reported_where_the_eye_focuses() {
     assert_eq!(s["focus_clamped"], true);
     let actual = s["focus_actual_d"].as_f64().unwrap();
     // A 4 mm pupil's spherical aberration moves the best focus a little from paraxial.
-    assert!((actual - far_point_d).abs() < 0.15, "{actual} vs {far_point_d}");
+    assert!(
+        (actual - far_point_d).abs() < 0.15,
+        "{actual} vs {far_point_d}"
+    );
     let o = render(&args, &out);
     let line = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(
@@ -258,7 +312,11 @@ fn focus_beyond_the_far_point_is_reported_where_the_eye_focuses() {
 fn pictures_and_bad_values_at_the_boundary() {
     let dir = temp_dir("pictures");
     let depth = dir.join("d.exr");
-    write_single_part(&depth, SIZE, vec![plane("Z", depth_values(SIZE, 2.0, 1e10))]);
+    write_single_part(
+        &depth,
+        SIZE,
+        vec![plane("Z", depth_values(SIZE, 2.0, 1e10))],
+    );
     let out = dir.join("out.exr");
     // Defect 6: PNG colour.
     let png = dir.join("c.png");
@@ -267,12 +325,29 @@ fn pictures_and_bad_values_at_the_boundary() {
         .unwrap();
     let s = json_ok(&render(
         &[
-            "--color", p(&png), "--depth", p(&depth), "--fov-y", "40", "--eye", "navarro",
-            "--focus-m", "2", "--white-cdm2", "150", "--json",
+            "--color",
+            p(&png),
+            "--depth",
+            p(&depth),
+            "--fov-y",
+            "40",
+            "--eye",
+            "navarro",
+            "--focus-m",
+            "2",
+            "--white-cdm2",
+            "150",
+            "--json",
         ],
         &out,
     ));
-    assert!(s["input"].as_str().unwrap().contains("sRGB, white 150 cd/m²"), "{s}");
+    assert!(
+        s["input"]
+            .as_str()
+            .unwrap()
+            .contains("sRGB, white 150 cd/m²"),
+        "{s}"
+    );
     // White 150 cd/m² through a normalised PSF: interior pixels stay at 150.
     let image = ocular::image_io::read_exr_rgba(&out).unwrap();
     let centre = image.pixels[8 * 16 + 8];
@@ -293,7 +368,11 @@ fn pictures_and_bad_values_at_the_boundary() {
         ],
     );
     let base = ["--color", p(&nan), "--depth", p(&depth), "--fov-y", "40"];
-    refused(&render(&base, &out), &out, &["nan.exr", "1 pixel(s)", "(7, 2)"]);
+    refused(
+        &render(&base, &out),
+        &out,
+        &["nan.exr", "1 pixel(s)", "(7, 2)"],
+    );
     let mut repaired = base.to_vec();
     repaired.extend_from_slice(&["--repair-nonfinite", "--eye", "navarro", "--focus-m", "2"]);
     let o = render(&repaired, &out);

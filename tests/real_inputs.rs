@@ -53,7 +53,11 @@ fn blender_multilayer_files_give_combined_colour_and_depth_z() {
     let got = inputs::load(&options(&cycles)).unwrap();
     assert_eq!(got.color.pixels[3], [13.0, 20.0, 30.0, 1.0]);
     assert!(got.color_source.contains("ViewLayer.Combined"));
-    assert!(got.depth_source.contains("ViewLayer.Depth.Z"), "{}", got.depth_source);
+    assert!(
+        got.depth_source.contains("ViewLayer.Depth.Z"),
+        "{}",
+        got.depth_source
+    );
     // Defect 2: the view-axis Depth.Z wins over Denoising Depth (×1.1) and Mist (0.5).
     assert_eq!(got.depth_m[0], f32::INFINITY, "1e10 is background");
     for i in [1, 17, 255] {
@@ -75,7 +79,11 @@ fn blender_multilayer_files_give_combined_colour_and_depth_z() {
     write_single_part(&eevee, SIZE, planes);
     let got = inputs::load(&options(&eevee)).unwrap();
     assert_eq!(got.color.pixels[2], [2.5, 1.0, 1.5, 1.0]);
-    assert_eq!(got.depth_m[0], f32::INFINITY, "65504 in a half channel is background");
+    assert_eq!(
+        got.depth_m[0],
+        f32::INFINITY,
+        "65504 in a half channel is background"
+    );
     assert_eq!(got.depth_m[16], 3.25);
 
     // File Output node, multilayer, slots Image and Depth: Image.{R,G,B,A}, Depth.V.
@@ -95,13 +103,20 @@ fn blender_multilayer_files_give_combined_colour_and_depth_z() {
     let got = inputs::load(&options(&node)).unwrap();
     assert_eq!(got.color.pixels[5], [7.0, 8.0, 9.0, 1.0]);
     assert!(got.depth_source.contains("Depth.V"));
-    assert_eq!(got.depth_m[16], 4.25, "Image.R (7) must not be read as depth");
+    assert_eq!(
+        got.depth_m[16], 4.25,
+        "Image.R (7) must not be read as depth"
+    );
 
     // A luminance-only (Y) EXR as colour, with a separate depth file.
     let grey = dir.join("y.exr");
     write_single_part(&grey, SIZE, vec![plane("Y", vec![0.25; n])]);
     let depth = dir.join("z.exr");
-    write_single_part(&depth, SIZE, vec![plane("Z", depth_values(SIZE, 1.0, 1e10))]);
+    write_single_part(
+        &depth,
+        SIZE,
+        vec![plane("Z", depth_values(SIZE, 1.0, 1e10))],
+    );
     let mut o = options(&grey);
     o.depth = Some(depth.clone());
     let got = inputs::load(&o).unwrap();
@@ -118,10 +133,7 @@ fn several_layers_need_a_choice_and_the_choice_picks_its_own_depth() {
     let mut planes = cycles_layer("ViewLayer", SIZE, 10.0, 2.0);
     planes.extend(combined("Composite", SIZE, 20.0));
     planes.extend(combined("Background", SIZE, 30.0));
-    planes.push(plane(
-        "Background.Depth.Z",
-        depth_values(SIZE, 6.0, 1e10),
-    ));
+    planes.push(plane("Background.Depth.Z", depth_values(SIZE, 6.0, 1e10)));
     write_single_part(&file, SIZE, planes);
     let (code, text) = error_of(&options(&file));
     assert_eq!(code, 2);
@@ -157,7 +169,10 @@ fn several_layers_need_a_choice_and_the_choice_picks_its_own_depth() {
 
     o.color_layer = Some("NoSuchLayer".into());
     let (_, text) = error_of(&o);
-    assert!(text.contains("NoSuchLayer") && text.contains("ViewLayer.Combined"), "{text}");
+    assert!(
+        text.contains("NoSuchLayer") && text.contains("ViewLayer.Combined"),
+        "{text}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -173,7 +188,10 @@ fn stereo_views_need_a_choice_and_depth_follows_the_view() {
     write_views(
         &path,
         SIZE,
-        vec![("left", "left", view(1.0, 2.0)), ("right", "right", view(5.0, 3.0))],
+        vec![
+            ("left", "left", view(1.0, 2.0)),
+            ("right", "right", view(5.0, 3.0)),
+        ],
     );
     let (code, text) = error_of(&options(&path));
     assert_eq!(code, 2);
@@ -210,12 +228,19 @@ fn depth_is_never_taken_from_the_wrong_pass_or_part() {
                     plane("B", vec![0.9; n]),
                 ],
             ),
-            ("ViewLayer.Depth", vec![plane("Z", depth_values(SIZE, 5.0, 1e10))]),
+            (
+                "ViewLayer.Depth",
+                vec![plane("Z", depth_values(SIZE, 5.0, 1e10))],
+            ),
         ],
     );
     let got = inputs::load(&options(&parts)).unwrap();
     assert_eq!(got.color.pixels[9], [0.7, 0.8, 0.9, 1.0]);
-    assert!(got.depth_source.contains("ViewLayer.Depth.Z"), "{}", got.depth_source);
+    assert!(
+        got.depth_source.contains("ViewLayer.Depth.Z"),
+        "{}",
+        got.depth_source
+    );
     assert_eq!(got.depth_m[33], 5.5);
 
     // Mist-only and Normal-only files are not depth: refused, listing what is there.
@@ -304,16 +329,26 @@ fn the_depth_policy_counts_background_invalid_and_near_pixels() {
     ];
     let (out, report) = apply(&raw, 5, false, 1.0);
     assert_eq!(report.background_px, 3, "1e10, +inf, 0");
-    assert_eq!(out[3], 65504.0, "65504 is only background in half-float files");
+    assert_eq!(
+        out[3], 65504.0,
+        "65504 is only background in half-float files"
+    );
     assert_eq!(report.invalid_px, 3);
     assert_eq!(report.first_invalid, Some((4, 0)));
-    assert!(out[..3].iter().chain(&out[4..7]).all(|&d| d == f32::INFINITY));
+    assert!(out[..3]
+        .iter()
+        .chain(&out[4..7])
+        .all(|&d| d == f32::INFINITY));
     assert_eq!(report.clamped_near_px, 1);
     assert!((out[7] - 1.0 / 49.875).abs() < 1e-8, "{}", out[7]);
     assert_eq!(report.constant_m, None);
     let warnings = report.warnings();
-    assert!(warnings.iter().any(|w| w.contains("3 pixel(s)") && w.contains("(4, 0)")));
-    assert!(warnings.iter().any(|w| w.starts_with("1 pixel(s) nearer than 0.0201 m")));
+    assert!(warnings
+        .iter()
+        .any(|w| w.contains("3 pixel(s)") && w.contains("(4, 0)")));
+    assert!(warnings
+        .iter()
+        .any(|w| w.starts_with("1 pixel(s) nearer than 0.0201 m")));
 
     // Half floats: 65504 is the background marker. --depth-scale converts units to metres
     // (centimetres here) after the background test on raw values.
@@ -321,7 +356,11 @@ fn the_depth_policy_counts_background_invalid_and_near_pixels() {
     assert_eq!(report.background_px, 1);
     assert_eq!(out, vec![f32::INFINITY, 1.5, 2.5]);
     let (_, report) = apply(&[1.0, 1.0, 1e10, 1.0], 2, false, 1.0);
-    assert_eq!(report.constant_m, Some(1.0), "background does not break constancy");
+    assert_eq!(
+        report.constant_m,
+        Some(1.0),
+        "background does not break constancy"
+    );
 }
 
 #[test]
@@ -352,8 +391,15 @@ fn non_finite_colour_is_refused_or_repaired_on_request() {
     o.repair_nonfinite = true;
     let got = inputs::load(&o).unwrap();
     assert_eq!(got.color.pixels[16 * 3 + 5], [0.0, 0.5, 0.5, 1.0]);
-    assert!(got.color.pixels.iter().all(|p| p.iter().all(|v| v.is_finite())));
-    assert!(got.warnings.iter().any(|w| w.contains("--repair-nonfinite")));
+    assert!(got
+        .color
+        .pixels
+        .iter()
+        .all(|p| p.iter().all(|v| v.is_finite())));
+    assert!(got
+        .warnings
+        .iter()
+        .any(|w| w.contains("--repair-nonfinite")));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -373,14 +419,20 @@ fn pictures_are_decoded_from_srgb_and_scaled_to_white() {
         .save(&png)
         .unwrap();
     let tif = dir.join("c.tif");
-    image::RgbImage::from_raw(4, 2, rgb).unwrap().save(&tif).unwrap();
+    image::RgbImage::from_raw(4, 2, rgb)
+        .unwrap()
+        .save(&tif)
+        .unwrap();
     for path in [&png, &tif] {
         let mut o = options(path);
         o.depth = Some(depth.clone());
         let got = inputs::load(&o).unwrap();
         assert_eq!(got.color.pixels[0], [0.0, 0.0, 0.0, 1.0]);
         assert!((got.color.pixels[1][0] - 80.0 * linear_128).abs() < 1e-3);
-        assert!((got.color.pixels[2][1] - 80.0).abs() < 1e-4, "white is 80 cd/m²");
+        assert!(
+            (got.color.pixels[2][1] - 80.0).abs() < 1e-4,
+            "white is 80 cd/m²"
+        );
         o.white_cdm2 = Some(250.0);
         let got = inputs::load(&o).unwrap();
         assert!((got.color.pixels[3][2] - 250.0 * linear_128).abs() < 1e-3);
@@ -401,7 +453,10 @@ fn pictures_are_decoded_from_srgb_and_scaled_to_white() {
     // A picture needs a depth EXR; --white-cdm2 is for pictures only.
     let (code, text) = error_of(&options(&png));
     assert_eq!(code, 2);
-    assert!(text.contains("--depth") || text.contains("depth must be an EXR"), "{text}");
+    assert!(
+        text.contains("--depth") || text.contains("depth must be an EXR"),
+        "{text}"
+    );
     // EXR colour is cd/m² unless --white-cdm2 says what 1.0 is (Blender's scene-linear
     // values are relative).
     let exr = dir.join("c.exr");
@@ -416,9 +471,15 @@ fn pictures_are_decoded_from_srgb_and_scaled_to_white() {
         ],
     );
     let mut o = options(&exr);
-    assert_eq!(inputs::load(&o).unwrap().color.pixels[0], [0.5, 0.25, 1.0, 1.0]);
+    assert_eq!(
+        inputs::load(&o).unwrap().color.pixels[0],
+        [0.5, 0.25, 1.0, 1.0]
+    );
     o.white_cdm2 = Some(100.0);
-    assert_eq!(inputs::load(&o).unwrap().color.pixels[0], [50.0, 25.0, 100.0, 1.0]);
+    assert_eq!(
+        inputs::load(&o).unwrap().color.pixels[0],
+        [50.0, 25.0, 100.0, 1.0]
+    );
     o.white_cdm2 = Some(-1.0);
     assert!(error_of(&o).1.contains("--white-cdm2"));
     let mut o = options(&dir.join("c.bmp"));
@@ -426,4 +487,3 @@ fn pictures_are_decoded_from_srgb_and_scaled_to_white() {
     assert!(error_of(&o).1.contains(".png"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
-

@@ -62,11 +62,21 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME", requires = "color")]
     pub depth_channel: Option<String>,
     /// Metres per scene unit of the depth file (Blender: Scene > Units > Unit Scale).
-    #[arg(long, value_name = "M", default_value_t = 1.0, allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     pub depth_scale: f64,
     /// Luminance of white in cd/m²: of sRGB white in PNG/JPEG/TIFF colour (default 80, the sRGB
     /// reference display), of 1.0 in EXR colour (default: EXR values are cd/m² already).
-    #[arg(long, value_name = "CD/M2", requires = "color", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "CD/M2",
+        requires = "color",
+        allow_negative_numbers = true
+    )]
     pub white_cdm2: Option<f64>,
     /// Render NaN or infinite colour samples of --color as black instead of refusing the file.
     #[arg(long, requires = "color")]
@@ -242,10 +252,13 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
     let mut depth_m = frame.depth_m;
     let mut warnings = Vec::new();
     let near = crate::render::focus::nearest_supported_m();
-    let clamped = depth_m.iter_mut().filter(|d| **d > 0.0 && **d < near).fold(0, |n, d| {
-        *d = near;
-        n + 1
-    });
+    let clamped = depth_m
+        .iter_mut()
+        .filter(|d| **d > 0.0 && **d < near)
+        .fold(0, |n, d| {
+            *d = near;
+            n + 1
+        });
     if clamped > 0 {
         warnings.push(format!(
             "scene {name}: {}",
@@ -289,7 +302,7 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
                 "--focus-m \"{text}\" is not a distance in metres or inf"
             ))
         })?;
-        if !(m > 0.0) {
+        if m.is_nan() || m <= 0.0 {
             return Err(Error::input(format!(
                 "--focus-m {m} must be a positive distance in metres (or inf)"
             )));

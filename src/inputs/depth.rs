@@ -81,15 +81,13 @@ pub fn apply(raw: &[f32], width: u32, half: bool, scale: f64) -> (Vec<f32>, Dept
         .iter()
         .enumerate()
         .map(|(i, &v)| {
-            let background = v == f32::INFINITY
-                || v == 0.0
-                || v >= BACKGROUND_FROM
-                || (half && v == HALF_MAX);
+            let background =
+                v == f32::INFINITY || v == 0.0 || v >= BACKGROUND_FROM || (half && v == HALF_MAX);
             if background {
                 report.background_px += 1;
                 return f32::INFINITY;
             }
-            if !(v > 0.0) || !v.is_finite() {
+            if v.is_nan() || v <= 0.0 || !v.is_finite() {
                 report.invalid_px += 1;
                 if report.first_invalid.is_none() {
                     let w = width.max(1) as usize;

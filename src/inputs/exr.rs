@@ -21,14 +21,7 @@ use crate::{Error, Result};
 /// Blender passes (and similar) that hold one value per pixel but are not view-axis depth:
 /// never taken as depth unless named with `--depth-channel`.
 const NOT_DEPTH_PASSES: [&str; 8] = [
-    "mist",
-    "normal",
-    "vector",
-    "ao",
-    "shadow",
-    "indexob",
-    "indexma",
-    "alpha",
+    "mist", "normal", "vector", "ao", "shadow", "indexob", "indexma", "alpha",
 ];
 
 /// One channel of a file, with its samples as f32.
@@ -187,11 +180,7 @@ impl ExrChannels {
     }
 
     fn names(&self) -> String {
-        let names: Vec<&str> = self
-            .channels
-            .iter()
-            .map(|c| c.full_name.as_str())
-            .collect();
+        let names: Vec<&str> = self.channels.iter().map(|c| c.full_name.as_str()).collect();
         names.join(", ")
     }
 
@@ -242,12 +231,13 @@ impl ExrChannels {
             .collect();
         let listing = || {
             if colour_groups.is_empty() {
-                format!("no colour layer (R, G, B or Y) among channels {}", self.names())
+                format!(
+                    "no colour layer (R, G, B or Y) among channels {}",
+                    self.names()
+                )
             } else {
-                let labels: Vec<String> = colour_groups
-                    .iter()
-                    .map(|g| Self::group_label(g))
-                    .collect();
+                let labels: Vec<String> =
+                    colour_groups.iter().map(|g| Self::group_label(g)).collect();
                 format!("colour layers found: {}", labels.join(", "))
             }
         };
@@ -267,7 +257,10 @@ impl ExrChannels {
                 _ => {
                     return Err(file_error(
                         path,
-                        format!("--color-layer {want:?} matches no colour layer; {}", listing()),
+                        format!(
+                            "--color-layer {want:?} matches no colour layer; {}",
+                            listing()
+                        ),
                     ))
                 }
             }

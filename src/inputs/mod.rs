@@ -95,8 +95,7 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
     };
     let (mut color, color_source, color_layer) = match &color_exr {
         Some(file) => {
-            let (mut image, group) =
-                file.color(&options.color, options.color_layer.as_deref())?;
+            let (mut image, group) = file.color(&options.color, options.color_layer.as_deref())?;
             if let Some(white) = options.white_cdm2 {
                 let k = white as f32;
                 for p in &mut image.pixels {

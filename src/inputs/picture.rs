@@ -43,9 +43,12 @@ pub fn read_picture(path: &Path, white_cdm2: f64) -> Result<(ImageRgba, Encoding
     let reader = reader
         .with_guessed_format()
         .map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let picture = reader
-        .decode()
-        .map_err(|e| Error::file(path, format!("not a readable PNG, JPEG or TIFF picture ({e})")))?;
+    let picture = reader.decode().map_err(|e| {
+        Error::file(
+            path,
+            format!("not a readable PNG, JPEG or TIFF picture ({e})"),
+        )
+    })?;
     let float = matches!(
         picture,
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)

@@ -107,8 +107,8 @@ pub fn effective_focus(
             beyond_far_point: false,
         });
     }
-    let actual_d = far_point_d(eye, pupil_mm, settings.accommodation_nm, focus_d)
-        .map_err(|e| fail(&e))?;
+    let actual_d =
+        far_point_d(eye, pupil_mm, settings.accommodation_nm, focus_d).map_err(|e| fail(&e))?;
     Ok(FocusOutcome {
         requested_d: focus_d,
         actual_d,

@@ -69,10 +69,13 @@ pub fn write_multi_part(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, V
             )
         })
         .collect();
-    Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))), layers)
-        .write()
-        .to_file(path)
-        .unwrap();
+    Image::from_layers(
+        ImageAttributes::new(IntegerBounds::from_dimensions((w, h))),
+        layers,
+    )
+    .write()
+    .to_file(path)
+    .unwrap();
 }
 
 /// A stereo multi-part file: one part per (name, view), the `view` attribute set.
@@ -82,13 +85,21 @@ pub fn write_views(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, &str, 
         .map(|(name, view, planes)| {
             let mut attributes = LayerAttributes::named(name);
             attributes.view_name = Some(Text::from(view));
-            Layer::new((w, h), attributes, Encoding::FAST_LOSSLESS, channels(planes))
+            Layer::new(
+                (w, h),
+                attributes,
+                Encoding::FAST_LOSSLESS,
+                channels(planes),
+            )
         })
         .collect();
-    Image::from_layers(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))), layers)
-        .write()
-        .to_file(path)
-        .unwrap();
+    Image::from_layers(
+        ImageAttributes::new(IntegerBounds::from_dimensions((w, h))),
+        layers,
+    )
+    .write()
+    .to_file(path)
+    .unwrap();
 }
 
 /// `<layer>.Combined.{R,G,B,A}` with distinct, recognisable values: R = `base` + x, G = 2·base,
@@ -130,10 +141,16 @@ pub fn cycles_layer(layer: &str, size: (usize, usize), base: f32, near: f32) -> 
         depth_values(size, near * 1.1, 0.0),
     ));
     for c in ["R", "G", "B"] {
-        planes.push(plane(&format!("{layer}.Denoising Albedo.{c}"), vec![0.8; n]));
+        planes.push(plane(
+            &format!("{layer}.Denoising Albedo.{c}"),
+            vec![0.8; n],
+        ));
     }
     for c in ["X", "Y", "Z"] {
-        planes.push(plane(&format!("{layer}.Denoising Normal.{c}"), vec![0.3; n]));
+        planes.push(plane(
+            &format!("{layer}.Denoising Normal.{c}"),
+            vec![0.3; n],
+        ));
     }
     planes
 }
