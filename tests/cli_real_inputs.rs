@@ -387,6 +387,13 @@ fn pictures_and_bad_values_at_the_boundary() {
         let o = render(&["--size", "32x18", ev], &png_out);
         refused(&o, &png_out, &["--exposure"]);
     }
+    // File options with a scene are refused, not ignored.
+    let png_out = dir.join("x.png");
+    refused(
+        &render(&["--scene", "chart", "--fov-y", "30"], &png_out),
+        &png_out,
+        &["--fov-y", "--color"],
+    );
     // The depth scale and white luminance are range-checked with their names.
     let mut bad_scale = base.to_vec();
     bad_scale.extend_from_slice(&["--depth-scale", "0"]);

@@ -202,7 +202,7 @@ fn stereo_views_need_a_choice_and_depth_follows_the_view() {
         "{text}"
     );
     let mut o = options(&path);
-    o.color_layer = Some("right.ViewLayer.Combined".into());
+    o.color_layer = Some("right".into());
     let got = inputs::load(&o).unwrap();
     assert_eq!(got.color.pixels[0][1], 10.0);
     assert_eq!(got.depth_m[16], 3.25, "the right view's depth");

@@ -116,10 +116,15 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 30.0)]
     pub age: f64,
     /// Vertical field of view in degrees; required with --color (scenes use their camera's).
-    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "DEG",
+        allow_negative_numbers = true,
+        requires = "color"
+    )]
     pub fov_y: Option<f64>,
-    /// Frame size for scenes (default 640x360).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    /// Frame size for scenes (default 640x360); files keep their own size.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with = "color")]
     pub size: Option<(u32, u32)>,
     /// Scene time in seconds (keyframes).
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
@@ -158,6 +163,29 @@ pub struct RenderArgs {
     /// Output image: .png (sRGB, tone-mapped) or .exr (linear).
     #[arg(short, long, value_name = "FILE", default_value = "ocular.png")]
     pub output: PathBuf,
+}
+
+/// Options that only mean something for file input are refused with a scene rather than
+/// ignored (clap's `requires` is not checked once --scene is given).
+fn check_file_options(args: &RenderArgs) -> Result<()> {
+    if args.color.is_some() {
+        return Ok(());
+    }
+    let given = [
+        ("--fov-y", args.fov_y.is_some()),
+        ("--depth", args.depth.is_some()),
+        ("--color-layer", args.color_layer.is_some()),
+        ("--depth-channel", args.depth_channel.is_some()),
+        ("--depth-scale", args.depth_scale != 1.0),
+        ("--white-cdm2", args.white_cdm2.is_some()),
+        ("--repair-nonfinite", args.repair_nonfinite),
+    ];
+    match given.iter().find(|(_, on)| *on) {
+        Some((name, _)) => Err(Error::input(format!(
+            "{name} applies to --color input; a scene has its own camera, depth and colour"
+        ))),
+        None => Ok(()),
+    }
 }
 
 fn check_fov(fov_y_deg: f64) -> Result<()> {
@@ -440,6 +468,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     if let Some(fov) = args.fov_y {
         check_fov(fov)?;
     }
+    check_file_options(args)?;
     if let Some(ev) = args.exposure {
         if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
             return Err(Error::input(format!(

@@ -252,6 +252,26 @@ impl ExrChannels {
             } else {
                 hits
             };
+            // A part (or layer) name: the one colour group inside it, its Combined if several.
+            let hits: Vec<&str> = if hits.is_empty() {
+                let inside: Vec<&str> = colour_groups
+                    .iter()
+                    .copied()
+                    .filter(|g| g.starts_with(&format!("{want}.")))
+                    .collect();
+                let combined: Vec<&str> = inside
+                    .iter()
+                    .copied()
+                    .filter(|g| self.pass_of(g).eq_ignore_ascii_case("combined"))
+                    .collect();
+                if inside.len() > 1 && !combined.is_empty() {
+                    combined
+                } else {
+                    inside
+                }
+            } else {
+                hits
+            };
             match hits.as_slice() {
                 [one] => one,
                 _ => {
