@@ -387,6 +387,13 @@ fn pictures_and_bad_values_at_the_boundary() {
         let o = render(&["--size", "32x18", ev], &png_out);
         refused(&o, &png_out, &["--exposure"]);
     }
+    // A focus nearer than the kernels reach names the option, in metres.
+    let png_out = dir.join("x.png");
+    refused(
+        &render(&["--size", "32x18", "--focus-m", "0.001"], &png_out),
+        &png_out,
+        &["--focus-m", "0.0010 m"],
+    );
     // File options with a scene are refused, not ignored.
     let png_out = dir.join("x.png");
     refused(

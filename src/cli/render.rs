@@ -319,7 +319,9 @@ pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
 
 /// The focus vergence asked for (D) and the words naming where it came from, for messages.
 fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
-    use crate::render::focus::{focus_d_of_distance_m, normalised_focus_d, vergence_of_depth_d};
+    use crate::render::focus::{
+        focus_d_of_distance_m, normalised_focus_d, pixel_vergence_d, PixelOnScreen,
+    };
     if let Some(text) = &args.focus_m {
         let t = text.trim().to_ascii_lowercase();
         if t == "inf" || t == "infinity" {
@@ -345,7 +347,17 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
         }
         return Ok((normalised_focus_d(d), "--focus-d".into()));
     }
-    let depth_at = |x: u32, y: u32| input.depth_m[(y * input.width + x) as usize];
+    let vergence_at = |x: u32, y: u32| {
+        let depth_m = input.depth_m[(y * input.width + x) as usize];
+        let at = PixelOnScreen {
+            x,
+            y,
+            width: input.width,
+            height: input.height,
+            fov_y_deg: input.fov_y_deg,
+        };
+        normalised_focus_d(pixel_vergence_d(depth_m, at))
+    };
     if let Some((x, y)) = args.focus_at {
         if x >= input.width || y >= input.height {
             return Err(Error::input(format!(
@@ -353,8 +365,7 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
                 input.width, input.height
             )));
         }
-        let d = normalised_focus_d(vergence_of_depth_d(depth_at(x, y)));
-        return Ok((d, format!("--focus-at {x},{y}")));
+        return Ok((vergence_at(x, y), format!("--focus-at {x},{y}")));
     }
     if let Some(m) = input.focus_m {
         let d = if m > 0.0 {
@@ -365,9 +376,8 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
         return Ok((d, "the scene's focus".into()));
     }
     let (x, y) = (input.width / 2, input.height / 2);
-    let d = normalised_focus_d(vergence_of_depth_d(depth_at(x, y)));
     Ok((
-        d,
+        vergence_at(x, y),
         format!("the default focus (depth at the frame centre {x},{y}; or use --focus-m)"),
     ))
 }

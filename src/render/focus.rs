@@ -37,6 +37,24 @@ pub fn vergence_of_depth_d(depth_m: f32) -> f64 {
     crate::render::reference::dioptre_of_depth(depth_m)
 }
 
+/// Where a pixel lies on the screen, for conversions that depend on its ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelOnScreen {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y_deg: f64,
+}
+
+/// The object vergence (D) of the pixel `at` whose depth buffer holds `depth_m`: what
+/// `--focus-at` and the default focus focus on. The one place to change if vergence becomes
+/// 1/(distance along the pixel's ray) rather than 1/(view-axis depth).
+pub fn pixel_vergence_d(depth_m: f32, at: PixelOnScreen) -> f64 {
+    let _ = at;
+    vergence_of_depth_d(depth_m)
+}
+
 /// The focus vergence (D) for a focus distance in metres: 0 (infinity) from
 /// [`FAR_FOCUS_M`] on, and for +∞.
 pub fn focus_d_of_distance_m(distance_m: f64) -> f64 {
