@@ -205,6 +205,8 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
             "{text}"
         );
         assert_eq!(s["warnings"].as_array().unwrap().len(), 1);
+        assert_eq!(s["depth_report"]["clamped_near_px"], 1);
+        assert_eq!(s["depth_report"]["background_px"], N / 2 + SIZE.0);
     }
 
     // Defect 8: a constant depth map (Blender's Z = 1 trap) is accepted with a warning.

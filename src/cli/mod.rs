@@ -38,7 +38,7 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Render a scene (or colour + depth EXRs) as an eye sees it — the main job.
+    /// Render a scene (or colour + depth files, e.g. from Blender) as an eye sees it — the main job.
     Render(Box<render::RenderArgs>),
     /// Export an animation (or a focus sweep) frame by frame; resumable and splittable.
     Video(Box<video::VideoArgs>),

@@ -224,8 +224,9 @@ struct Input {
     pupil_mm: Option<f64>,
     luminance_cdm2: Option<f64>,
     label: String,
-    /// Where the depth came from (file input).
+    /// Where the depth came from, and what the depth policy found (file input).
     depth_source: Option<String>,
+    depth_report: Option<crate::inputs::DepthReport>,
     warnings: Vec<String>,
 }
 
@@ -258,6 +259,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
             luminance_cdm2: None,
             label: file.color_source,
             depth_source: Some(file.depth_source),
+            depth_report: Some(file.depth_report),
             warnings: file.warnings,
         });
     }
@@ -304,6 +306,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
         luminance_cdm2: state.luminance_cd_m2,
         label: format!("scene {name}"),
         depth_source: None,
+        depth_report: None,
         warnings,
     })
 }
@@ -434,6 +437,8 @@ struct Summary {
     fov_y_deg: f64,
     /// Where the depth came from (file input only).
     depth: Option<String>,
+    /// Background, invalid, clamped and constant depth (file input only).
+    depth_report: Option<crate::inputs::DepthReport>,
     /// The focus asked for (D; 0 = infinity).
     focus_d: f64,
     /// Where the eye actually focuses (D): `focus_d`, or its far point when `focus_d` lies
@@ -560,6 +565,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         height: input.height,
         fov_y_deg: input.fov_y_deg,
         depth: input.depth_source.clone(),
+        depth_report: input.depth_report.clone(),
         focus_d,
         focus_actual_d: focus.actual_d,
         focus_clamped: focus.beyond_far_point,
