@@ -1,5 +1,6 @@
 //! `ocular render`: the main job — a scene (or colour + depth files from a renderer) as a
-//! particular eye sees it. With no arguments: the `primitives` scene through the `myopia` eye into ocular.png.
+//! particular eye sees it. With no arguments: the `primitives` scene through the `myopia` eye
+//! into ocular.png. File input is read and checked by `crate::inputs`.
 
 use std::path::PathBuf;
 
