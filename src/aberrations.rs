@@ -16,18 +16,38 @@
 //! Repeated (n, m) are summed. Unknown keys are errors.
 //!
 //! **CSV**, `*.csv`: one `j,coefficient_um` pair per line, j the OSA single index (0 = piston).
-//! Blank lines and lines starting with `#` are ignored, except the header lines
+//! Blank lines, lines starting with `#` and everything after a `#` later in a line (an inline
+//! comment) are ignored, except the header lines
 //! `# pupil_diameter_mm = 5.0` and `# wavelength_nm = 550`, which set the pupil and
 //! wavelength. A first line `j,coefficient_um` (any case) is skipped. Pupil and wavelength given
 //! to [`ZernikeSet::from_csv_str`] / [`ZernikeSet::load`] override the header lines; one of the
 //! two sources must provide each.
 //!
 //! **ABP**, `*.abp` (the seed paper's framework): lines `Ap = <pupil mm>`, `Wa = <nm>` and
-//! `Z[n, m] = <µm>`; blank lines and lines starting with `#`, `//` or `%` are ignored.
+//! `Z[n, m] = <µm>`; blank lines and lines starting with `#`, `//` or `%` are ignored, and so
+//! is an inline comment after a value (`Z[1, -1] = -1.150  # estimated`, also `//` or `%`), as
+//! in the framework's own presets.
+//!
+//! A UTF-8 byte-order mark at the start of a CSV or ABP file is ignored.
 
 use crate::optics::zernike::{is_valid_nm, num_terms, osa_index, osa_nm, rescale_pupil};
 use serde::Deserialize;
 use std::path::Path;
+
+/// The line up to the first of `markers` (an inline or whole-line comment), trimmed. No value
+/// in these formats contains a comment marker, so the first one always starts the comment.
+fn strip_inline_comment<'a>(line: &'a str, markers: &[&str]) -> &'a str {
+    let end = markers
+        .iter()
+        .filter_map(|m| line.find(m))
+        .min()
+        .unwrap_or(line.len());
+    line[..end].trim()
+}
+
+fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
 
 /// Highest order accepted in files.
 pub const MAX_FILE_ORDER: u32 = 30;
@@ -164,13 +184,14 @@ impl ZernikeSet {
         let mut pupil = None;
         let mut wl = None;
         let mut coefficients = Vec::new();
-        for (i, raw) in text.lines().enumerate() {
+        for (i, raw) in without_bom(text).lines().enumerate() {
             let line = i + 1;
             let s = raw.trim();
             if s.is_empty() {
                 continue;
             }
             if let Some(c) = s.strip_prefix('#') {
+                let c = strip_inline_comment(c, &["#"]);
                 if let Some((k, v)) = c.split_once('=') {
                     let key = k.trim().to_ascii_lowercase();
                     let val: Option<f64> = v.trim().parse().ok();
@@ -189,6 +210,7 @@ impl ZernikeSet {
                 }
                 continue;
             }
+            let s = strip_inline_comment(s, &["#"]);
             if coefficients.is_empty()
                 && s.to_ascii_lowercase().replace(' ', "") == "j,coefficient_um"
             {
@@ -252,10 +274,10 @@ impl ZernikeSet {
         let mut pupil = None;
         let mut wl = None;
         let mut coefficients = Vec::new();
-        for (i, raw) in text.lines().enumerate() {
+        for (i, raw) in without_bom(text).lines().enumerate() {
             let line = i + 1;
-            let s = raw.trim();
-            if s.is_empty() || s.starts_with('#') || s.starts_with("//") || s.starts_with('%') {
+            let s = strip_inline_comment(raw, &["#", "//", "%"]);
+            if s.is_empty() {
                 continue;
             }
             let err = |message: String| AberrationError::Parse {
@@ -269,10 +291,12 @@ impl ZernikeSet {
                 ))
             })?;
             let k = k.trim();
-            let val: f64 = v
-                .trim()
-                .parse()
-                .map_err(|_| err(format!("value {:?} is not a number", v.trim())))?;
+            let val: f64 = v.trim().parse().map_err(|_| {
+                err(format!(
+                    "value {:?} is not a number (a number may be followed by a # comment)",
+                    v.trim()
+                ))
+            })?;
             if k.eq_ignore_ascii_case("ap") {
                 pupil = Some(val);
             } else if k.eq_ignore_ascii_case("wa") {

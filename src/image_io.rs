@@ -203,129 +203,29 @@ fn check_size(path: &Path, width: u32, height: u32, len: usize) -> Result<()> {
     Ok(())
 }
 
-/// Reads the first RGB(A) layer of an EXR as f32 (missing alpha reads as 1).
+/// Reads the colour of an EXR as f32 (missing alpha reads as 1): the one `<layer>.Combined`
+/// group, else the one RGB group, else the one luminance (Y) group (see
+/// [`crate::inputs::exr`]); several candidates or none is an error that lists them.
 pub fn read_exr_rgba(path: impl AsRef<Path>) -> Result<ImageRgba> {
-    use exr::prelude::*;
     let path = path.as_ref();
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .rgba_channels(
-            |resolution, _| ImageRgba {
-                width: resolution.width() as u32,
-                height: resolution.height() as u32,
-                pixels: vec![[0.0; 4]; resolution.width() * resolution.height()],
-            },
-            |image: &mut ImageRgba, position, (r, g, b, a): (f32, f32, f32, f32)| {
-                let i = position.y() * image.width as usize + position.x();
-                image.pixels[i] = [r, g, b, a];
-            },
-        )
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| exr_read_error(path, e, "R, G and B channels (A optional)"))?;
-    Ok(image.layer_data.channel_data.pixels)
+    let file = crate::inputs::exr::ExrChannels::read(path)?;
+    Ok(file.color(path, None)?.0)
 }
 
-fn exr_read_error(path: &Path, error: exr::error::Error, wanted: &str) -> Error {
-    match error {
-        exr::error::Error::Io(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            file_error(path, "no such file")
-        }
-        exr::error::Error::Io(e) => file_error(path, format!("cannot read: {e}")),
-        exr::error::Error::NotSupported(m) => {
-            file_error(path, format!("unsupported EXR feature: {m}"))
-        }
-        exr::error::Error::Invalid(m) if m.contains("layer") || m.contains("channel") => {
-            file_error(path, format!("not an EXR with {wanted}: {m}"))
-        }
-        e => file_error(path, format!("not a valid EXR file ({e})")),
-    }
-}
-
-/// Channel names accepted for depth, in order of preference.
-const DEPTH_CHANNELS: [&str; 4] = ["Z", "depth", "Y", "R"];
-
-/// Reads one channel of an EXR: the first of Z, depth, Y, R present (case-insensitive, also
-/// as the last component of a layered name such as `view.Z`), or the only channel. When
-/// several candidates are present it says on stderr which one it used.
+/// Reads the depth channel of an EXR, raw (no background or unit policy): a `Depth` pass
+/// (`ViewLayer.Depth.Z`, `Depth.V`), a channel named Z or depth, or the only channel of a
+/// one-channel file (see [`crate::inputs::exr`]).
 pub fn read_exr_depth(path: impl AsRef<Path>) -> Result<ImageGray> {
-    let path = path.as_ref();
-    let (image, used, candidates) = read_exr_depth_channel(path)?;
-    if candidates.len() > 1 {
-        eprintln!(
-            "note: {}: using channel {used} as depth (candidates present: {})",
-            path.display(),
-            candidates.join(", ")
-        );
-    }
-    Ok(image)
+    Ok(read_exr_depth_channel(path)?.0)
 }
 
 /// As `read_exr_depth`, also returning the channel used and every candidate channel present.
 pub fn read_exr_depth_channel(path: impl AsRef<Path>) -> Result<(ImageGray, String, Vec<String>)> {
-    use exr::prelude::*;
     let path = path.as_ref();
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .map_err(|e| exr_read_error(path, e, "a depth channel"))?;
-    let layer = &image.layer_data;
-    let names: Vec<String> = layer
-        .channel_data
-        .list
-        .iter()
-        .map(|c| c.name.to_string())
-        .collect();
-    let base = |name: &str| name.rsplit('.').next().unwrap_or(name).to_lowercase();
-    let chosen = if names.len() == 1 {
-        0
-    } else {
-        DEPTH_CHANNELS
-            .iter()
-            .find_map(|want| names.iter().position(|n| base(n) == want.to_lowercase()))
-            .ok_or_else(|| {
-                file_error(
-                    path,
-                    format!(
-                        "no depth channel: found {}; expected one named Z, depth, Y or R, or a \
-                         single-channel file",
-                        names.join(", ")
-                    ),
-                )
-            })?
-    };
-    let candidates: Vec<String> = names
-        .iter()
-        .filter(|n| DEPTH_CHANNELS.iter().any(|w| base(n) == w.to_lowercase()))
-        .cloned()
-        .collect();
-    let size = layer.size;
-    let samples = &layer.channel_data.list[chosen].sample_data;
-    let pixels: Vec<f32> = samples.values_as_f32().collect();
-    if pixels.len() != size.width() * size.height() {
-        return Err(file_error(
-            path,
-            format!(
-                "channel {} is subsampled; ocular needs full resolution",
-                names[chosen]
-            ),
-        ));
-    }
-    Ok((
-        ImageGray {
-            width: size.width() as u32,
-            height: size.height() as u32,
-            pixels,
-        },
-        names[chosen].clone(),
-        candidates,
-    ))
+    let file = crate::inputs::exr::ExrChannels::read(path)?;
+    let (channel, candidates) = file.depth(path, None, None)?;
+    let raw = crate::inputs::exr::RawDepth::from_channel(channel, candidates);
+    Ok((raw.image, raw.channel, raw.candidates))
 }
 
 /// Writes linear RGBA as 32-bit float EXR (channels R, G, B, A).

@@ -10,6 +10,7 @@ pub mod error;
 pub mod eye;
 pub mod gpu;
 pub mod image_io;
+pub mod inputs;
 pub mod metrics;
 pub mod optics;
 pub mod psf;

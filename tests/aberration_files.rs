@@ -135,6 +135,36 @@ fn abp_format() {
 }
 
 #[test]
+fn inline_comments_and_blank_lines_are_ignored() {
+    // As in two of the seed framework's presets: comments after values, blank lines, a BOM.
+    let text = "\u{feff}# keratoconus, estimated\nAp = 5.0   # mm\n\n  Wa = 470.0 % nm\n\
+                Z[1, -1] = -1.150  # estimated\nZ[3, 1] = 0.25 // coma\n";
+    let s = ZernikeSet::from_abp_str(text, "k.abp").unwrap();
+    assert_eq!(s.wavelength_nm, 470.0);
+    assert_eq!(s.coefficients, vec![(1, -1, -1.15), (3, 1, 0.25)]);
+    // A bad value is still refused with file:line and what is allowed.
+    let e = ZernikeSet::from_abp_str("Ap = 5\nWa = 500\n\nZ[2, 0] = 1.0x # typo\n", "k.abp")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("k.abp:4:") && e.contains("\"1.0x\"") && e.contains("number"),
+        "{e}"
+    );
+    // CSV: inline comments after data and header values.
+    let csv = "# pupil_diameter_mm = 6.0  # measured\n4, 0.5  # defocus\n\n12,0.1\n";
+    let s = ZernikeSet::from_csv_str(csv, "w.csv", None, Some(555.0)).unwrap();
+    assert_eq!(s.pupil_diameter_mm, 6.0);
+    assert_eq!(s.coefficients, vec![(2, 0, 0.5), (4, 0, 0.1)]);
+    let e = ZernikeSet::from_csv_str("4, 0.5\n5 # no value\n", "w.csv", Some(5.0), Some(600.0))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("w.csv:2:") && e.contains("j,coefficient_um"),
+        "{e}"
+    );
+}
+
+#[test]
 fn load_from_files_by_extension() {
     let dir = std::env::temp_dir().join(format!("ocular-ab-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

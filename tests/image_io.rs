@@ -82,7 +82,7 @@ fn rgb_exr_reads_with_alpha_one_and_depth_prefers_z() {
     assert_eq!(image.pixels[4 + 2], [2.0, 1.0, 0.5, 1.0]);
     assert!(image.pixels.iter().all(|p| p[3] == 1.0));
 
-    // R, G, B and Z: Z is the depth, and the choice is reported.
+    // R, G, B and Z: Z is the depth, and R is no candidate (it is colour).
     let mixed = dir.join("mixed.exr");
     Image::from_channels(
         (4, 3),
@@ -98,7 +98,7 @@ fn rgb_exr_reads_with_alpha_one_and_depth_prefers_z() {
     .unwrap();
     let (depth, channel, candidates) = read_exr_depth_channel(&mixed).unwrap();
     assert_eq!(channel, "Z");
-    assert!(candidates.contains(&"R".to_string()));
+    assert_eq!(candidates, vec!["Z".to_string()]);
     assert_eq!(depth.pixels[1], 11.0);
 
     // Two channels, neither a depth name: an error that lists them.

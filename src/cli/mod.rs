@@ -38,7 +38,7 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Render a scene (or colour + depth EXRs) as an eye sees it — the main job.
+    /// Render a scene (or colour + depth files, e.g. from Blender) as an eye sees it — the main job.
     Render(Box<render::RenderArgs>),
     /// Export an animation (or a focus sweep) frame by frame; resumable and splittable.
     Video(Box<video::VideoArgs>),
@@ -159,8 +159,8 @@ pub(crate) fn measured_scene_frame(
 )> {
     let state = scene.at_time(0.0);
     let frame = crate::render::Rasterizer::new(ctx)?.render(ctx, &state, width, height)?;
-    let focus_d = if state.focus_m.is_finite() && state.focus_m > 0.0 {
-        1.0 / state.focus_m
+    let focus_d = if state.focus_m > 0.0 {
+        crate::render::focus::focus_d_of_distance_m(state.focus_m)
     } else {
         0.0
     };

@@ -1,5 +1,6 @@
-//! `ocular render`: the main job — a scene (or a colour + depth EXR pair) as a particular eye
-//! sees it. With no arguments: the `primitives` scene through the `myopia` eye into ocular.png.
+//! `ocular render`: the main job — a scene (or colour + depth files from a renderer) as a
+//! particular eye sees it. With no arguments: the `primitives` scene through the `myopia` eye
+//! into ocular.png. File input is read and checked by `crate::inputs`.
 
 use std::path::PathBuf;
 
@@ -34,21 +35,53 @@ pub enum PupilModel {
     ocular render                                   # primitives, myopia eye → ocular.png\n  \
     ocular render --scene chart --eye keratoconus --focus-m 6 -o chart.png\n  \
     ocular render --color c.exr --depth d.exr --fov-y 60 --eye astigmatism --focus-m 7.5 --pupil-mm 5 -o out.exr\n  \
+    ocular render --color blender.exr --fov-y 22.9 --eye myopia          # Combined + Depth.Z of one file\n  \
+    ocular render --color photo.png --depth d.exr --fov-y 40 --white-cdm2 200\n  \
     ocular render --scene colonnade --focus-at 320,180 --luminance-cdm2 30 --timings\n\n\
 Focus: --focus-m/--focus-d, or --focus-at X,Y (the depth under that pixel), else the scene's \
-focus, else the depth at the frame's centre. Pupil: --pupil-mm, else from --luminance-cdm2, the \
+focus, else the depth at the frame's centre; background is infinitely far and focus distances \
+from 1e4 m on are infinity. Pupil: --pupil-mm, else from --luminance-cdm2, the \
 scene's pupil or luminance, or the frame's mean luminance (linear RGB is in cd/m²). Kernels are \
 computed only for what the frame needs and cached (see --cache).")]
 pub struct RenderArgs {
     /// Built-in scene (primitives, chart, colonnade) or a scene .toml file.
     #[arg(long, value_name = "NAME|FILE", conflicts_with = "color")]
     pub scene: Option<String>,
-    /// Linear colour EXR (instead of a scene); needs --depth.
-    #[arg(long, value_name = "FILE.exr", requires = "depth")]
+    /// Colour instead of a scene: a linear EXR (Blender's multilayer included: its
+    /// <layer>.Combined pass) or an sRGB PNG/JPEG/TIFF. Needs --fov-y.
+    #[arg(long, value_name = "FILE")]
     pub color: Option<PathBuf>,
-    /// Depth EXR in metres along the view axis (channel Z, depth, Y or R).
+    /// Depth EXR along the view axis in scene units (see --depth-scale): a Depth pass
+    /// (ViewLayer.Depth.Z, Depth.V), a channel Z or depth, or a one-channel file. Default: the
+    /// --color EXR.
     #[arg(long, value_name = "FILE.exr", requires = "color")]
     pub depth: Option<PathBuf>,
+    /// EXR colour layer when the file has several (ViewLayer, Composite.Combined, Image, …).
+    #[arg(long, value_name = "NAME", requires = "color")]
+    pub color_layer: Option<String>,
+    /// EXR depth channel by its full name (ViewLayer.Depth.Z, Depth.V, Z, …).
+    #[arg(long, value_name = "NAME", requires = "color")]
+    pub depth_channel: Option<String>,
+    /// Metres per scene unit of the depth file (Blender: Scene > Units > Unit Scale).
+    #[arg(
+        long,
+        value_name = "M",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
+    pub depth_scale: f64,
+    /// Luminance of white in cd/m²: of sRGB white in PNG/JPEG/TIFF colour (default 80, the sRGB
+    /// reference display), of 1.0 in EXR colour (default: EXR values are cd/m² already).
+    #[arg(
+        long,
+        value_name = "CD/M2",
+        requires = "color",
+        allow_negative_numbers = true
+    )]
+    pub white_cdm2: Option<f64>,
+    /// Render NaN or infinite colour samples of --color as black instead of refusing the file.
+    #[arg(long, requires = "color")]
+    pub repair_nonfinite: bool,
     /// Eye: a preset (see `ocular eye list`) or an eye .toml file.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
@@ -83,11 +116,16 @@ pub struct RenderArgs {
     /// Observer age (years) for the Watson–Yellott formula.
     #[arg(long, default_value_t = 30.0)]
     pub age: f64,
-    /// Vertical field of view in degrees (EXR input; scenes use their camera's).
-    #[arg(long, value_name = "DEG")]
+    /// Vertical field of view in degrees; required with --color (scenes use their camera's).
+    #[arg(
+        long,
+        value_name = "DEG",
+        allow_negative_numbers = true,
+        requires = "color"
+    )]
     pub fov_y: Option<f64>,
-    /// Frame size for scenes (default 640x360).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    /// Frame size for scenes (default 640x360); files keep their own size.
+    #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with = "color")]
     pub size: Option<(u32, u32)>,
     /// Scene time in seconds (keyframes).
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
@@ -130,6 +168,39 @@ pub struct RenderArgs {
     pub output: PathBuf,
 }
 
+/// Options that only mean something for file input are refused with a scene rather than
+/// ignored (clap's `requires` is not checked once --scene is given).
+fn check_file_options(args: &RenderArgs) -> Result<()> {
+    if args.color.is_some() {
+        return Ok(());
+    }
+    let given = [
+        ("--fov-y", args.fov_y.is_some()),
+        ("--depth", args.depth.is_some()),
+        ("--color-layer", args.color_layer.is_some()),
+        ("--depth-channel", args.depth_channel.is_some()),
+        ("--depth-scale", args.depth_scale != 1.0),
+        ("--white-cdm2", args.white_cdm2.is_some()),
+        ("--repair-nonfinite", args.repair_nonfinite),
+    ];
+    match given.iter().find(|(_, on)| *on) {
+        Some((name, _)) => Err(Error::input(format!(
+            "{name} applies to --color input; a scene has its own camera, depth and colour"
+        ))),
+        None => Ok(()),
+    }
+}
+
+fn check_fov(fov_y_deg: f64) -> Result<()> {
+    if fov_y_deg.is_finite() && fov_y_deg > 0.0 && fov_y_deg < 180.0 {
+        Ok(())
+    } else {
+        Err(Error::input(format!(
+            "--fov-y {fov_y_deg} must be a vertical field of view in (0, 180) degrees"
+        )))
+    }
+}
+
 fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
     let (x, y) = text
         .split_once(',')
@@ -156,28 +227,43 @@ struct Input {
     pupil_mm: Option<f64>,
     luminance_cdm2: Option<f64>,
     label: String,
+    /// Where the depth came from, and what the depth policy found (file input).
+    depth_source: Option<String>,
+    depth_report: Option<crate::inputs::DepthReport>,
+    warnings: Vec<String>,
 }
 
 fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
-    if let (Some(color_path), Some(depth_path)) = (&args.color, &args.depth) {
-        let color = image_io::read_exr_rgba(color_path)?;
-        let depth = image_io::read_exr_depth(depth_path)?;
-        if (color.width, color.height) != (depth.width, depth.height) {
-            return Err(Error::input(format!(
-                "--color is {}×{} but --depth is {}×{}; they must match",
-                color.width, color.height, depth.width, depth.height
-            )));
-        }
+    if let Some(color_path) = &args.color {
+        let fov_y_deg = args.fov_y.ok_or_else(|| {
+            Error::input(
+                "--fov-y DEG is required with --color: the camera's vertical field of view in \
+                 degrees (Blender shows the horizontal one for landscape frames; see the README)",
+            )
+        })?;
+        check_fov(fov_y_deg)?;
+        let file = crate::inputs::load(&crate::inputs::FileInputOptions {
+            color: color_path.clone(),
+            depth: args.depth.clone(),
+            color_layer: args.color_layer.clone(),
+            depth_channel: args.depth_channel.clone(),
+            depth_scale: args.depth_scale,
+            white_cdm2: args.white_cdm2,
+            repair_nonfinite: args.repair_nonfinite,
+        })?;
         return Ok(Input {
-            width: color.width,
-            height: color.height,
-            color: color.pixels,
-            depth_m: depth.pixels,
-            fov_y_deg: args.fov_y.unwrap_or(60.0),
+            width: file.color.width,
+            height: file.color.height,
+            color: file.color.pixels,
+            depth_m: file.depth_m,
+            fov_y_deg,
             focus_m: None,
             pupil_mm: None,
             luminance_cdm2: None,
-            label: color_path.display().to_string(),
+            label: file.color_source,
+            depth_source: Some(file.depth_source),
+            depth_report: Some(file.depth_report),
+            warnings: file.warnings,
         });
     }
     let _ = cli;
@@ -196,16 +282,35 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
     let (width, height) = args.size.unwrap_or((640, 360));
     let mut rasterizer = Rasterizer::new(ctx)?;
     let frame = rasterizer.render(ctx, &state, width, height)?;
+    let mut depth_m = frame.depth_m;
+    let mut warnings = Vec::new();
+    let near = crate::render::focus::nearest_supported_m();
+    let clamped = depth_m
+        .iter_mut()
+        .filter(|d| **d > 0.0 && **d < near)
+        .fold(0, |n, d| {
+            *d = near;
+            n + 1
+        });
+    if clamped > 0 {
+        warnings.push(format!(
+            "scene {name}: {}",
+            crate::inputs::depth::near_clamp_warning(clamped)
+        ));
+    }
     Ok(Input {
         width,
         height,
         color: frame.color,
-        depth_m: frame.depth_m,
+        depth_m,
         fov_y_deg: state.camera.fov_y_deg,
         focus_m: Some(state.focus_m),
         pupil_mm: state.pupil_mm,
         luminance_cdm2: state.luminance_cd_m2,
         label: format!("scene {name}"),
+        depth_source: None,
+        depth_report: None,
+        warnings,
     })
 }
 
@@ -218,23 +323,27 @@ pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
     }
 }
 
-fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
+/// The focus vergence asked for (D) and the words naming where it came from, for messages.
+fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
+    use crate::render::focus::{
+        focus_d_of_distance_m, normalised_focus_d, pixel_vergence_d, PixelOnScreen,
+    };
     if let Some(text) = &args.focus_m {
         let t = text.trim().to_ascii_lowercase();
         if t == "inf" || t == "infinity" {
-            return Ok(0.0);
+            return Ok((0.0, "--focus-m".into()));
         }
         let m: f64 = t.parse().map_err(|_| {
             Error::input(format!(
                 "--focus-m \"{text}\" is not a distance in metres or inf"
             ))
         })?;
-        if !(m.is_finite() && m > 0.0) {
+        if m.is_nan() || m <= 0.0 {
             return Err(Error::input(format!(
                 "--focus-m {m} must be a positive distance in metres (or inf)"
             )));
         }
-        return Ok(1.0 / m);
+        return Ok((focus_d_of_distance_m(m), "--focus-m".into()));
     }
     if let Some(d) = args.focus_d {
         if !(d.is_finite() && d >= 0.0) {
@@ -242,16 +351,19 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
                 "--focus-d {d} must be a non-negative vergence in dioptres"
             )));
         }
-        return Ok(d);
+        return Ok((normalised_focus_d(d), "--focus-d".into()));
     }
-    let projection = crate::render::projection::Projection {
-        width: input.width,
-        height: input.height,
-        fov_y_deg: input.fov_y_deg,
+    let vergence_at = |x: u32, y: u32| {
+        let depth_m = input.depth_m[(y * input.width + x) as usize];
+        let at = PixelOnScreen {
+            x,
+            y,
+            width: input.width,
+            height: input.height,
+            fov_y_deg: input.fov_y_deg,
+        };
+        normalised_focus_d(pixel_vergence_d(depth_m, at))
     };
-    // Vergence along the pixel's ray, as every method uses it.
-    let dioptre_at =
-        |x: u32, y: u32| projection.dioptre_at(x, y, input.depth_m[(y * input.width + x) as usize]);
     if let Some((x, y)) = args.focus_at {
         if x >= input.width || y >= input.height {
             return Err(Error::input(format!(
@@ -259,16 +371,21 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<f64> {
                 input.width, input.height
             )));
         }
-        return Ok(dioptre_at(x, y));
+        return Ok((vergence_at(x, y), format!("--focus-at {x},{y}")));
     }
     if let Some(m) = input.focus_m {
-        return Ok(if m.is_finite() && m > 0.0 {
-            1.0 / m
+        let d = if m > 0.0 {
+            focus_d_of_distance_m(m)
         } else {
             0.0
-        });
+        };
+        return Ok((d, "the scene's focus".into()));
     }
-    Ok(dioptre_at(input.width / 2, input.height / 2))
+    let (x, y) = (input.width / 2, input.height / 2);
+    Ok((
+        vergence_at(x, y),
+        format!("the default focus (depth at the frame centre {x},{y}; or use --focus-m)"),
+    ))
 }
 
 /// Mean luminance (cd/m²) of linear Rec.709 RGB.
@@ -321,9 +438,20 @@ struct Summary {
     width: u32,
     height: u32,
     fov_y_deg: f64,
+    /// Where the depth came from (file input only).
+    depth: Option<String>,
+    /// Background, invalid, clamped and constant depth (file input only).
+    depth_report: Option<crate::inputs::DepthReport>,
+    /// The focus asked for (D; 0 = infinity).
     focus_d: f64,
+    /// Where the eye actually focuses (D): `focus_d`, or its far point when `focus_d` lies
+    /// beyond it (`focus_clamped`).
+    focus_actual_d: f64,
+    focus_clamped: bool,
     pupil_mm: f64,
     pupil_source: String,
+    /// Things about the input a user should know (also printed on stderr).
+    warnings: Vec<String>,
     method: &'static str,
     seconds_render: f64,
     seconds_kernels: f64,
@@ -356,18 +484,41 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         },
         &args.blend,
     )?;
-    let eye = load_eye(&args.eye)?;
-    let ctx = Context::new(&cli.context_options())?;
-    let input = load_input(cli, args, &ctx)?;
     if let Some(fov) = args.fov_y {
-        if !(fov.is_finite() && fov > 0.0 && fov < 180.0) {
+        check_fov(fov)?;
+    }
+    check_file_options(args)?;
+    if let Some(ev) = args.exposure {
+        if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
             return Err(Error::input(format!(
-                "--fov-y {fov} must lie in (0, 180) degrees"
+                "--exposure {ev} must be a number of EV in [-64, 64]"
             )));
         }
     }
-    let focus_d = focus_dioptres(args, &input)?;
+    let eye = load_eye(&args.eye)?;
+    let ctx = Context::new(&cli.context_options())?;
+    let input = load_input(cli, args, &ctx)?;
+    for w in &input.warnings {
+        eprintln!("warning: {w}");
+    }
+    let (focus_d, focus_from) = focus_dioptres(args, &input)?;
+    if focus_d > crate::render::focus::MAX_OBJECT_VERGENCE_D {
+        return Err(Error::input(format!(
+            "{focus_from}: a focus at {:.4} m ({focus_d:.1} D) is nearer than ocular renders \
+             (at most {} D, 2 cm)",
+            1.0 / focus_d,
+            crate::render::focus::MAX_OBJECT_VERGENCE_D
+        )));
+    }
     let (pupil_mm, pupil_source) = pupil_diameter(args, &input)?;
+    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let focus = crate::render::focus::effective_focus(
+        &eye,
+        focus_d,
+        pupil_mm,
+        &options.settings,
+        &focus_from,
+    )?;
     let state = EyeState { focus_d, pupil_mm };
     let screen = Screen {
         fov_y_deg: input.fov_y_deg,
@@ -383,7 +534,6 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         &[state],
         screen,
     );
-    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let kernels = prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
     let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
@@ -428,9 +578,14 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         width: input.width,
         height: input.height,
         fov_y_deg: input.fov_y_deg,
+        depth: input.depth_source.clone(),
+        depth_report: input.depth_report.clone(),
         focus_d,
+        focus_actual_d: focus.actual_d,
+        focus_clamped: focus.beyond_far_point,
         pupil_mm,
         pupil_source,
+        warnings: input.warnings.clone(),
         method: args.method.name(),
         seconds_render: frame.seconds,
         seconds_kernels,
@@ -449,10 +604,21 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let focus = if focus_d > 0.0 {
-        format!("{:.3} m", 1.0 / focus_d)
+    let distance = |d: f64| {
+        if d > 0.0 {
+            format!("{:.3} m", 1.0 / d)
+        } else {
+            "infinity".into()
+        }
+    };
+    let focus = if focus.beyond_far_point {
+        format!(
+            "{} (its far point; asked {}, beyond it)",
+            distance(focus.actual_d),
+            distance(focus_d)
+        )
     } else {
-        "infinity".into()
+        distance(focus_d)
     };
     println!(
         "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",

@@ -2,6 +2,7 @@
 //! is one Rust file plus GLSL files of the same stem under glsl/render/.
 
 pub mod blend;
+pub mod focus;
 pub mod frame;
 pub mod projection;
 pub mod raster;

@@ -31,5 +31,6 @@ pub fn finish(ctx: Context) {
     }
 }
 
+pub mod blender;
 pub mod splat_cpu;
 pub mod synthetic;

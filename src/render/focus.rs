@@ -1,0 +1,169 @@
+//! Where the eye focuses: depth → vergence, distances too far to matter, and the far point
+//! of an eye that cannot relax enough.
+
+use crate::eye::accommodate::accommodate;
+use crate::eye::measure::Measurer;
+use crate::eye::Eye;
+use crate::optics::zernike::osa_index;
+use crate::psf::axes::{GridAxes, KernelSettings};
+use crate::{Error, Result};
+
+/// The largest object vergence the kernels cover (the planner's limit), in dioptres.
+pub const MAX_OBJECT_VERGENCE_D: f64 = 50.0;
+
+/// The nearest depth ocular renders, in metres (about 2 cm): the reciprocal of the largest
+/// object vergence on the reference grid's spacing within [`MAX_OBJECT_VERGENCE_D`], since the
+/// planner brackets a scene's range with grid points. Depths nearer are clamped to it; it is
+/// rounded up in f32 so that its vergence never exceeds that grid point.
+pub fn nearest_supported_m() -> f32 {
+    let o = GridAxes::default().objects;
+    let top_d = o.min_d + o.step_d * ((MAX_OBJECT_VERGENCE_D - o.min_d) / o.step_d + 1e-9).floor();
+    let m = (1.0 / top_d) as f32;
+    if 1.0 / f64::from(m) > top_d {
+        m.next_up()
+    } else {
+        m
+    }
+}
+
+/// Focus distances from this far on are infinity: the vergence (≤ 1e-4 D) is far below any
+/// eye's depth of field, and accommodating to it numerically is ill-posed.
+pub const FAR_FOCUS_M: f64 = 1e4;
+
+/// The object vergence (D) of a depth `depth_m` along the view axis, ignoring the pixel's
+/// direction; background (+∞, 0, NaN, negative) is optical infinity. Per-pixel conversions go
+/// through [`pixel_vergence_d`] (distance along the ray).
+pub fn vergence_of_depth_d(depth_m: f32) -> f64 {
+    crate::render::reference::dioptre_of_depth(depth_m)
+}
+
+/// Where a pixel lies on the screen, for conversions that depend on its ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelOnScreen {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+    pub fov_y_deg: f64,
+}
+
+/// The object vergence (D) of the pixel `at` whose depth buffer holds `depth_m`: what
+/// `--focus-at` and the default focus focus on. Light reaches the eye with the vergence of the
+/// distance along the pixel's ray (see [`crate::render::projection`]), as every method uses.
+pub fn pixel_vergence_d(depth_m: f32, at: PixelOnScreen) -> f64 {
+    crate::render::projection::Projection {
+        width: at.width,
+        height: at.height,
+        fov_y_deg: at.fov_y_deg,
+    }
+    .dioptre_at(at.x, at.y, depth_m)
+}
+
+/// The focus vergence (D) for a focus distance in metres: 0 (infinity) from
+/// [`FAR_FOCUS_M`] on, and for +∞.
+pub fn focus_d_of_distance_m(distance_m: f64) -> f64 {
+    if distance_m >= FAR_FOCUS_M {
+        0.0
+    } else {
+        1.0 / distance_m
+    }
+}
+
+/// A focus vergence with vergences nearer infinity than [`FAR_FOCUS_M`] set to exactly 0.
+pub fn normalised_focus_d(focus_d: f64) -> f64 {
+    if focus_d < 1.0 / FAR_FOCUS_M {
+        0.0
+    } else {
+        focus_d
+    }
+}
+
+/// The focus asked for and the one the eye reaches.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct FocusOutcome {
+    pub requested_d: f64,
+    /// Where the eye actually focuses (D): the request, or the far point when the request
+    /// lies beyond it.
+    pub actual_d: f64,
+    /// The request lies beyond the eye's far point: the eye stays relaxed.
+    pub beyond_far_point: bool,
+}
+
+/// Object distance (m) of a vergence, `None` for infinity.
+fn distance_of(focus_d: f64) -> Option<f64> {
+    (focus_d > 0.0).then(|| 1.0 / focus_d)
+}
+
+/// Checks that `eye` can focus at `focus_d` with `pupil_mm` and, where the request lies
+/// beyond the far point (a myopic eye asked to focus far), finds the far point the relaxed
+/// eye actually focuses at — the same criterion (c(2,0) = 0 at the accommodation wavelength)
+/// the kernels use. `what` names the options that set the focus, for errors.
+pub fn effective_focus(
+    eye: &Eye,
+    focus_d: f64,
+    pupil_mm: f64,
+    settings: &KernelSettings,
+    what: &str,
+) -> Result<FocusOutcome> {
+    let fail = |e: &dyn std::fmt::Display| {
+        let at = match distance_of(focus_d) {
+            Some(m) => format!("{m:.4} m ({focus_d:.4} D)"),
+            None => "infinity".into(),
+        };
+        Error::input(format!(
+            "{what}: the eye cannot focus at {at} with a {pupil_mm} mm pupil (--pupil-mm): {e}"
+        ))
+    };
+    let acc = accommodate(
+        eye,
+        distance_of(focus_d),
+        pupil_mm,
+        settings.accommodation_nm,
+    )
+    .map_err(|e| fail(&e))?;
+    let beyond = settings.far_point_limit && acc.diameter_mm > eye.lens.diameter_mm;
+    if !beyond {
+        return Ok(FocusOutcome {
+            requested_d: focus_d,
+            actual_d: focus_d,
+            beyond_far_point: false,
+        });
+    }
+    let actual_d =
+        far_point_d(eye, pupil_mm, settings.accommodation_nm, focus_d).map_err(|e| fail(&e))?;
+    Ok(FocusOutcome {
+        requested_d: focus_d,
+        actual_d,
+        beyond_far_point: true,
+    })
+}
+
+/// The vergence (D) at which the relaxed `eye` has no Zernike defocus, found by the secant
+/// method from `start_d` (c(2,0) is close to linear in the object vergence).
+fn far_point_d(eye: &Eye, pupil_mm: f64, wavelength_nm: f64, start_d: f64) -> Result<f64> {
+    let sys = eye.system()?;
+    let meas = Measurer::new(4, 6, 16);
+    let j20 = osa_index(2, 0);
+    let mut buf = [0.0; 15];
+    let mut c20 = |v: f64| -> Result<f64> {
+        meas.coefficients_um(&sys, wavelength_nm, pupil_mm, distance_of(v), &mut buf)?;
+        Ok(buf[j20])
+    };
+    let (mut v0, mut v1) = (start_d, start_d + 0.5);
+    let (mut g0, mut g1) = (c20(v0)?, c20(v1)?);
+    for _ in 0..30 {
+        if g1.abs() < 1e-7 || g1 == g0 {
+            break;
+        }
+        let v2 = (v1 - g1 * (v1 - v0) / (g1 - g0)).clamp(0.0, MAX_OBJECT_VERGENCE_D);
+        (v0, g0) = (v1, g1);
+        v1 = v2;
+        g1 = c20(v1)?;
+    }
+    if g1.abs() > 1e-4 {
+        return Err(Error::input(format!(
+            "the relaxed eye's far point was not found (c(2,0) = {g1:.2e} µm at {v1:.3} D)"
+        )));
+    }
+    Ok(v1)
+}
