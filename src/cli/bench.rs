@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use clap::Args;
 
-use super::raster::parse_size;
+use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
@@ -31,7 +31,7 @@ pub struct BenchArgs {
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
     /// Frame size.
-    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x720")]
+    #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "1280x720")]
     pub size: (u32, u32),
     /// Frames rendered before timing starts (shader compilation, caches).
     #[arg(long, default_value_t = 5)]

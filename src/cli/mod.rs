@@ -11,10 +11,13 @@ mod devices;
 mod eye;
 mod eye_plot;
 mod kernels;
+mod outputs;
 mod psf;
 mod raster;
 mod render;
+mod sha256;
 mod video;
+mod video_manifest;
 
 #[derive(Debug, Parser)]
 #[command(

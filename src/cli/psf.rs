@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
+use super::outputs::Outputs;
 use crate::aberrations::{self, ZernikeSet};
 use crate::image_io::{self, ImageGray, ImageRgba, Tonemap, TonemapMode};
 use crate::optics::beta::StilesCrawford;
@@ -135,6 +136,14 @@ fn positive(name: &str, value: f64) -> Result<f64> {
 }
 
 pub fn run(args: &PsfArgs) -> Result<()> {
+    let mut outputs = Outputs::new();
+    outputs.add("-o", &args.output, &["exr"])?;
+    let sidecar_file = sidecar_path(&args.output);
+    outputs.add("-o (its JSON sidecar)", &sidecar_file, &["json"])?;
+    if let Some(png) = &args.png {
+        outputs.add("--png", png, &["png"])?;
+    }
+    outputs.probe()?;
     let (set, source) = load_set(args)?;
     let pupil_mm = positive("--pupil-mm", args.pupil_mm.unwrap_or(set.pupil_diameter_mm))?;
     if pupil_mm > set.pupil_diameter_mm + 1e-9 {
@@ -203,9 +212,13 @@ pub fn run(args: &PsfArgs) -> Result<()> {
     }
     let normalised: Vec<f32> = psf.intensity.iter().map(|v| (v / total) as f32).collect();
     let n = args.size as u32;
-    image_io::write_exr_gray(&args.output, &ImageGray::new(n, n, normalised.clone()), "Y")?;
+    image_io::write_exr_gray(
+        outputs.temporary(&args.output),
+        &ImageGray::new(n, n, normalised.clone()),
+        "Y",
+    )?;
     if let Some(png) = &args.png {
-        write_log_preview(png, n, &normalised)?;
+        write_log_preview(outputs.temporary(png), n, &normalised)?;
     }
     let sidecar = Sidecar {
         source: &source,
@@ -234,7 +247,8 @@ pub fn run(args: &PsfArgs) -> Result<()> {
     };
     let text = serde_json::to_string_pretty(&sidecar)
         .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-    image_io::write_text_atomic(sidecar_path(&args.output), &text)?;
+    image_io::write_text_atomic(outputs.temporary(&sidecar_file), &text)?;
+    outputs.commit()?;
     if args.json {
         println!("{text}");
     } else {
