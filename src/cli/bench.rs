@@ -45,6 +45,7 @@ pub struct BenchArgs {
     /// Screen tile size: 8, 16 or 32.
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
+    /// Storage of the PSF texture the splatting samples.
     #[arg(long, value_enum, default_value = "rgba16f")]
     pub texture_format: PsfTextureFormat,
     /// Fragment merging: 0 = off, 1 = 2×2, 2 = also 4×4.
@@ -56,6 +57,7 @@ pub struct BenchArgs {
     /// Kernel cache folder (default: the user cache); --no-cache times the precomputation.
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
+    /// Neither read nor write the kernel cache.
     #[arg(long)]
     pub no_cache: bool,
     /// Write the results as JSON.

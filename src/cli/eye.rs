@@ -93,8 +93,10 @@ pub struct EstimateArgs {
 pub struct ShowArgs {
     /// Eye file or preset name.
     pub eye: String,
+    /// Wavelength of the derived optics (nm).
     #[arg(long, default_value_t = 555.0)]
     pub wavelength_nm: f64,
+    /// Pupil diameter of the derived optics (mm, 1–9).
     #[arg(long, default_value_t = 5.0)]
     pub pupil_mm: f64,
 }
@@ -103,8 +105,10 @@ pub struct ShowArgs {
 pub struct MeasureArgs {
     /// Eye file or preset name.
     pub eye: String,
+    /// Pupil diameter the wavefront is measured over (mm, 1–9).
     #[arg(long)]
     pub pupil_mm: f64,
+    /// Wavelength of the measurement (nm).
     #[arg(long)]
     pub wavelength_nm: f64,
     /// Distance the eye focuses on, and where the measured object point sits (m or "inf").
@@ -113,6 +117,7 @@ pub struct MeasureArgs {
     /// Highest Zernike order (1–10).
     #[arg(long, default_value_t = 6)]
     pub order: u32,
+    /// Print the measurement as JSON.
     #[arg(long)]
     pub json: bool,
 }
@@ -121,10 +126,13 @@ pub struct MeasureArgs {
 pub struct DrawArgs {
     /// Eye file or preset name.
     pub eye: String,
+    /// Where to write the drawing (SVG).
     #[arg(short = 'o', long, value_name = "EYE.svg")]
     pub output: PathBuf,
+    /// Pupil diameter of the ray bundles (mm, 1–9).
     #[arg(long, default_value_t = 4.0)]
     pub pupil_mm: f64,
+    /// Wavelength the rays are traced at (nm).
     #[arg(long, default_value_t = 555.0)]
     pub wavelength_nm: f64,
     /// Focus distances of the two panels (m or "inf").
@@ -163,6 +171,12 @@ fn check_pupil(p: f64) -> Result<()> {
 
 /// The target wavefront from the options, and a one-line description of its source.
 fn target(a: &EstimateArgs) -> Result<(ZernikeSet, String)> {
+    if !a.terms.is_empty() && a.rx.is_none() {
+        return Err(Error::input(
+            "--term adds higher-order terms to --rx \"S C x A\"; a --zernike file or --preset \
+             gives all its own terms",
+        ));
+    }
     finite_option("pupil-mm", a.pupil_mm)?;
     finite_option("wavelength-nm", a.wavelength_nm)?;
     if let Some(p) = a.pupil_mm {

@@ -194,7 +194,7 @@ pub fn run(args: &PsfArgs) -> Result<()> {
         });
     }
     let started = std::time::Instant::now();
-    let psf = compute_psf(&request)?;
+    let psf = compute_psf(&request).map_err(|e| option_error(e, args, pupil_mm, wavelength_nm))?;
     let seconds = started.elapsed().as_secs_f64();
     let total: f64 = psf.intensity.iter().sum();
     if !(total.is_finite() && total > 0.0) {
@@ -266,6 +266,55 @@ pub fn run(args: &PsfArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The optics core names its own quantities (`defocus_f`, `pitch_lambda_over_na`, the grid
+/// extent); the user gave options, so the message names those and their allowed values.
+fn option_error(
+    e: crate::optics::OpticsError,
+    args: &PsfArgs,
+    pupil_mm: f64,
+    wavelength_nm: f64,
+) -> Error {
+    use crate::optics::OpticsError;
+    let OpticsError::OutOfRange { field, .. } = &e else {
+        return e.into();
+    };
+    let per_dioptre = defocus_f_from_dioptres(1.0, pupil_mm, wavelength_nm).abs();
+    let limit_d = 5000.0 / per_dioptre.max(f64::MIN_POSITIVE);
+    if field.contains("defocus") {
+        Error::input(format!(
+            "--defocus-d {}: with the set's own defocus this is more than a {pupil_mm} mm pupil at \
+             {wavelength_nm} nm allows (|total defocus| up to about {limit_d:.0} D)",
+            args.defocus_d
+        ))
+    } else if field.contains("grid extent") {
+        Error::input(format!(
+            "--size {} with --pitch-arcmin {}: the grid reaches too far from the optical axis for \
+             this pupil and wavelength; lower --size or --pitch-arcmin",
+            args.size, args.pitch_arcmin
+        ))
+    } else if field.contains("pitch") {
+        Error::input(format!(
+            "--pitch-arcmin {} is outside what the computation allows for a {pupil_mm} mm pupil \
+             at {wavelength_nm} nm ({:.2e} to {:.2e} arcmin)",
+            args.pitch_arcmin,
+            arcmin_from_pitch(1e-4, pupil_mm, wavelength_nm),
+            arcmin_from_pitch(1e3, pupil_mm, wavelength_nm)
+        ))
+    } else if field == "max_degree" {
+        Error::input(format!(
+            "--max-degree {} is outside 1 to 300",
+            args.max_degree
+        ))
+    } else if field == "beta_tolerance" {
+        Error::input(format!(
+            "--beta-tolerance {} is outside 1e-14 to 0.5",
+            args.beta_tolerance
+        ))
+    } else {
+        e.into()
+    }
 }
 
 /// `psf.exr` → `psf.json`.
