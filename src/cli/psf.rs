@@ -24,8 +24,8 @@ Examples:\n  ocular psf --preset keratoconus -o kc.exr --png kc.png\n  \
 ocular psf --zernike eye.abp --pupil-mm 4 --wavelength-nm 550 --defocus-d 1.5 --size 512 -o psf.exr"
 )]
 pub struct PsfArgs {
-    /// Zernike file: our TOML format, CSV (`j,coefficient_um` with `# pupil_mm = …` and
-    /// `# wavelength_nm = …` header lines) or an `.abp` file.
+    /// Zernike file: our TOML format, CSV (`j,coefficient_um` with `# pupil_diameter_mm = …`
+    /// and `# wavelength_nm = …` header lines) or an `.abp` file.
     #[arg(
         long,
         value_name = "FILE",
