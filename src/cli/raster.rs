@@ -25,9 +25,9 @@ pub enum TonemapArg {
     ocular raster --scene my_room.toml --size 640x360 --time 2.5 --png preview.png\n\n\
 Colour is linear Rec.709 RGB whose luminance Y = 0.2126R + 0.7152G + 0.0722B is in cd/m²; \
 depth is the distance along the view direction in metres (32-bit float, channel Z). \
-Built-in scenes: primitives, chart, colonnade (see scenes/README.md for the file format).")]
+Built-in scenes: primitives, chart, colonnade, walk (see scenes/README.md for the file format).")]
 pub struct RasterArgs {
-    /// Built-in scene name (primitives, chart, colonnade) or path to a scene .toml file.
+    /// Built-in scene name (primitives, chart, colonnade, walk) or path to a scene .toml file.
     #[arg(long, value_name = "NAME|FILE")]
     pub scene: String,
 

@@ -37,8 +37,8 @@ pub enum FrameFormat {
 
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
-    ocular video --scene colonnade --eye myopia --fps 30 -o frames/ --mp4 walk.mp4\n  \
-    ocular video --scene chart --eye healthy --side-by-side keratoconus -o cmp/\n  \
+    ocular video --scene walk --eye myopia -o frames/ --mp4 walk.mp4\n  \
+    ocular video --scene walk --eye healthy --side-by-side keratoconus -o cmp/\n  \
     ocular video --scene primitives --eye healthy --focus-sweep 0.2..7.5 --duration 4 -o sweep/\n\n\
 Split a long export across machines with --frames A..B (frames A to B−1): each job writes its own \
 files into the same folder, and the union is identical to one run. The folder's ocular-video.json \
@@ -67,7 +67,7 @@ pub struct VideoArgs {
     /// Frame file format.
     #[arg(long, value_enum, default_value = "png")]
     pub format: FrameFormat,
-    /// Frame size (default 640x360).
+    /// Frame size (default: the scene's `resolution`).
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
     /// Render every frame through this second eye as well, side by side and labelled.
@@ -385,7 +385,10 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         count,
         sweep,
     };
-    let (width, height) = args.size.unwrap_or((640, 360));
+    let (width, height) = args.size.unwrap_or((
+        timeline.scene.resolution[0],
+        timeline.scene.resolution[1],
+    ));
     let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let splat = SplatSettings::default();
     let config = ExportConfig {
