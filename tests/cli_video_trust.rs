@@ -190,3 +190,28 @@ fn side_by_side_errors_name_their_own_option() {
     assert!(!err.contains("--eye"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn only_dead_jobs_temporaries_are_removed() {
+    let dir = temp_dir("temporaries");
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .unwrap()
+        .trim()
+        .replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_");
+    let mut child = Command::new("true").spawn().unwrap();
+    let dead = child.id();
+    child.wait().unwrap();
+    let ours_dead = format!("frame_000002.png.tmp-{host}-{dead}");
+    let ours_live = format!("frame_000003.png.tmp-{host}-{}", std::process::id());
+    let elsewhere = "frame_000001.png.tmp-another-machine-4242".to_string();
+    for name in [&ours_dead, &ours_live, &elsewhere] {
+        std::fs::write(dir.join(name), b"partial").unwrap();
+    }
+    ok(&video(&dir, &[]));
+    assert!(!dir.join(&ours_dead).exists(), "a dead job's temporary stays");
+    // A split job still writing (here, or on another machine sharing the folder) keeps its
+    // temporary: removing it would make its rename fail.
+    assert!(dir.join(&ours_live).exists());
+    assert!(dir.join(&elsewhere).exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -138,6 +138,12 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     if args.frames == 0 {
         return Err(Error::input("--frames must be at least 1"));
     }
+    // The report's path is checked before minutes of benchmarking, not after.
+    let mut outputs = super::outputs::Outputs::new();
+    if let Some(path) = &args.json {
+        outputs.add("--json", path, &["json"])?;
+    }
+    outputs.probe()?;
     let splat = super::splat_settings(
         args.tile_size,
         args.texture_format,
@@ -243,7 +249,10 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-        crate::image_io::write_text_atomic(path, &text)?;
+        crate::image_io::write_text_atomic(outputs.temporary(path), &text)?;
+    }
+    outputs.commit()?;
+    if let Some(path) = &args.json {
         println!("wrote {}", path.display());
     }
     Ok(())

@@ -539,7 +539,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         // The digest is durable before the frame has its final name, so every frame a later
         // run finds under a final name can be verified.
         log.record(&name, &bytes)?;
-        super::write_atomic(&path, &bytes)?;
+        write_frame(&args.output, &name, &bytes)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -580,14 +580,76 @@ fn probe_writable(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Temporaries left by an interrupted run (`NAME.tmp-PID`) are never valid frames.
+/// This machine's name, so that a job on a shared folder can tell its own machine's
+/// temporaries from those of jobs running elsewhere.
+fn host_name() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_"))
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "host".to_string())
+}
+
+/// Where frame `name` is written before its rename: `NAME.tmp-HOST-PID`.
+fn temporary_name(name: &str) -> String {
+    format!("{name}.tmp-{}-{}", host_name(), std::process::id())
+}
+
+/// Writes a frame through a temporary name, synced, then renamed into place.
+fn write_frame(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let path = dir.join(name);
+    let tmp = dir.join(temporary_name(name));
+    let result = (|| -> std::io::Result<()> {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&tmp, &path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::file(&path, format!("cannot write the frame: {e}")));
+    }
+    Ok(())
+}
+
+/// Temporaries are never valid frames. Removed: those of this machine whose process is gone,
+/// and any older than an hour (a frame takes seconds to write). A live split job's
+/// temporaries, here or on another machine sharing the folder, are left alone.
 fn remove_stale_temporaries(dir: &Path) {
-    if let Ok(entries) = std::fs::read_dir(dir) {
-        for entry in entries.flatten() {
-            let name = entry.file_name().to_string_lossy().into_owned();
-            if name.starts_with("frame_") && name.contains(".tmp-") {
-                let _ = std::fs::remove_file(entry.path());
-            }
+    let host = host_name();
+    // Without /proc a process cannot be looked up: only age decides.
+    let alive = |pid: u32| {
+        !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists()
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some((_, owner)) = name.split_once(".tmp-") else {
+            continue;
+        };
+        if !name.starts_with("frame_") {
+            continue;
+        }
+        let gone = match owner.rsplit_once('-') {
+            Some((h, pid)) if h == host => pid.parse::<u32>().is_ok_and(|pid| !alive(pid)),
+            // Another machine's.
+            Some(_) => false,
+            // The older `NAME.tmp-PID` form.
+            None => owner.parse::<u32>().is_ok_and(|pid| !alive(pid)),
+        };
+        let old = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age.as_secs() > 3600);
+        if gone || old {
+            let _ = std::fs::remove_file(entry.path());
         }
     }
 }
