@@ -111,8 +111,7 @@ pub fn ssim(a: ImageView<'_>, b: ImageView<'_>, data_range: f64) -> Ssim {
                 let s = ((2.0 * ux * uy + c1) * (2.0 * cov + c2))
                     / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
                 map[i] += s / 3.0;
-                let inside =
-                    row >= radius && col >= radius && row + radius < h && col + radius < w;
+                let inside = row >= radius && col >= radius && row + radius < h && col + radius < w;
                 if inside {
                     valid_sum += s;
                     valid_count += 1;

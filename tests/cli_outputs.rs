@@ -57,7 +57,13 @@ fn outputs_must_be_named_for_their_format() {
         &["-o", "c.png", ".exr"],
     );
     refused(
-        &ocular(&["raster", "--scene", "primitives", "--png", p(&d.join("c.exr"))]),
+        &ocular(&[
+            "raster",
+            "--scene",
+            "primitives",
+            "--png",
+            p(&d.join("c.exr")),
+        ]),
         &["--png", ".png"],
     );
     refused(
@@ -190,7 +196,11 @@ fn a_failing_second_output_leaves_nothing_behind() {
         "--png",
         p(&d.join("p.png")),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(files_in(&d), ["p.exr", "p.json", "p.png"]);
 }
 
@@ -249,7 +259,12 @@ fn psf_errors_name_the_options_given() {
         let o = ocular(&args);
         refused(&o, &[want]);
         let err = String::from_utf8_lossy(&o.stderr);
-        for internal in ["defocus_f", "pitch_lambda_over_na", "max_degree", "grid extent"] {
+        for internal in [
+            "defocus_f",
+            "pitch_lambda_over_na",
+            "max_degree",
+            "grid extent",
+        ] {
             assert!(!err.contains(internal), "{internal} leaks into: {err}");
         }
     }
@@ -273,10 +288,21 @@ fn device_is_an_index_or_a_name_and_cpu_commands_refuse_it() {
         &["--device", "psf", "CPU"],
     );
     refused(
-        &ocular(&["kernels", "--eye", "navarro", "-o", p(&d.join("g.bin")), "--device", "0"]),
+        &ocular(&[
+            "kernels",
+            "--eye",
+            "navarro",
+            "-o",
+            p(&d.join("g.bin")),
+            "--device",
+            "0",
+        ]),
         &["--device", "kernels"],
     );
-    refused(&ocular(&["eye", "list", "--device", "0"]), &["--device", "eye"]);
+    refused(
+        &ocular(&["eye", "list", "--device", "0"]),
+        &["--device", "eye"],
+    );
     // OCULAR_DEVICE is a preference for GPU commands: the CPU ones run with it set.
     let out = Command::new(env!("CARGO_BIN_EXE_ocular"))
         .env("OCULAR_DEVICE", "0")
@@ -320,15 +346,25 @@ fn eye_estimate_term_needs_rx_and_csv_may_carry_a_bom() {
         "-o",
         p(&d.join("w.exr")),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let sidecar: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("w.json")).unwrap()).unwrap();
     assert_eq!(sidecar["pupil_mm"], 5.0);
     assert_eq!(sidecar["coefficients"].as_array().unwrap().len(), 2);
 
     let list = String::from_utf8_lossy(&ocular(&["eye", "list"]).stdout).into_owned();
-    assert!(!list.contains("1 terms") && !list.contains("order 0"), "{list}");
-    assert!(list.contains("healthy") && list.contains("aberration-free"), "{list}");
+    assert!(
+        !list.contains("1 terms") && !list.contains("order 0"),
+        "{list}"
+    );
+    assert!(
+        list.contains("healthy") && list.contains("aberration-free"),
+        "{list}"
+    );
 }
 
 /// Sends `signal` to a running estimate; it must write the best eye (not converged) and exit

@@ -87,14 +87,21 @@ fn a_resume_with_another_configuration_is_refused() {
     assert_eq!(before.len(), 4);
     assert!(dir.join("ocular-video.json").is_file());
 
-    refused(&video(&dir, &["--eye", "myopia"]), &["--eye navarro there, myopia here", "--overwrite"]);
+    refused(
+        &video(&dir, &["--eye", "myopia"]),
+        &["--eye navarro there, myopia here", "--overwrite"],
+    );
     refused(
         &video(&dir, &["--size", "192x108"]),
         &["--size 160x90 there, 192x108 here"],
     );
     refused(&video(&dir, &["--fps", "20"]), &["--fps"]);
     refused(&video(&dir, &["--pupil-mm", "3"]), &["--pupil-mm"]);
-    assert_eq!(frames(&dir), before, "a refused run must not touch the frames");
+    assert_eq!(
+        frames(&dir),
+        before,
+        "a refused run must not touch the frames"
+    );
 
     // The same configuration resumes and skips every (verified) frame.
     let report = ok(&video(&dir, &[]));
@@ -105,7 +112,10 @@ fn a_resume_with_another_configuration_is_refused() {
     assert!(report.contains("rendered 4"), "{report}");
     let after = frames(&dir);
     assert_eq!(after.len(), 4);
-    assert_ne!(after, before, "the myopic frames differ from the Navarro ones");
+    assert_ne!(
+        after, before,
+        "the myopic frames differ from the Navarro ones"
+    );
     refused(&video(&dir, &[]), &["--eye myopia there, navarro here"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -144,7 +154,10 @@ fn exr_splits_are_byte_identical_to_one_run() {
     let (a, b) = (frames(&whole), frames(&split));
     assert_eq!(a.len(), 4);
     for ((name, x), (_, y)) in a.iter().zip(&b) {
-        assert!(x == y, "{name}: the split's bytes differ from the whole run's");
+        assert!(
+            x == y,
+            "{name}: the split's bytes differ from the whole run's"
+        );
     }
     // The digests the jobs recorded are standard SHA-256 of the frames (sha256sum format).
     let sums: String = std::fs::read_dir(split.join("ocular-video.sums"))
@@ -153,7 +166,9 @@ fn exr_splits_are_byte_identical_to_one_run() {
         .map(|e| std::fs::read_to_string(e.path()).unwrap())
         .collect();
     assert_eq!(sums.lines().count(), 4, "{sums}");
-    assert!(sums.lines().all(|l| l.len() == 64 + 2 + "frame_000000.exr".len()));
+    assert!(sums
+        .lines()
+        .all(|l| l.len() == 64 + 2 + "frame_000000.exr".len()));
     let _ = std::fs::remove_dir_all(&whole);
     let _ = std::fs::remove_dir_all(&split);
 }
@@ -163,7 +178,14 @@ fn mp4_without_ffmpeg_fails_before_rendering() {
     let dir = temp_dir("mp4");
     let out = Command::new(env!("CARGO_BIN_EXE_ocular"))
         .env("PATH", "/nonexistent")
-        .args(["video", "--scene", "primitives", "--size", "160x90", "--mp4"])
+        .args([
+            "video",
+            "--scene",
+            "primitives",
+            "--size",
+            "160x90",
+            "--mp4",
+        ])
         .arg(dir.join("walk.mp4"))
         .arg("-o")
         .arg(dir.join("frames"))
@@ -185,8 +207,8 @@ fn side_by_side_errors_name_their_own_option() {
         &video(&dir, &["--side-by-side", "hyperopia"]),
         &["--side-by-side"],
     );
-    let err = String::from_utf8_lossy(&video(&dir, &["--side-by-side", "hyperopia"]).stderr)
-        .into_owned();
+    let err =
+        String::from_utf8_lossy(&video(&dir, &["--side-by-side", "hyperopia"]).stderr).into_owned();
     assert!(!err.contains("--eye"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -208,7 +230,10 @@ fn only_dead_jobs_temporaries_are_removed() {
         std::fs::write(dir.join(name), b"partial").unwrap();
     }
     ok(&video(&dir, &[]));
-    assert!(!dir.join(&ours_dead).exists(), "a dead job's temporary stays");
+    assert!(
+        !dir.join(&ours_dead).exists(),
+        "a dead job's temporary stays"
+    );
     // A split job still writing (here, or on another machine sharing the folder) keeps its
     // temporary: removing it would make its rename fail.
     assert!(dir.join(&ours_live).exists());

@@ -23,7 +23,7 @@ fn noisy(width: u32, height: u32) -> ImageRgba {
     let pixels = (0..width * height)
         .map(|i| {
             // Flat runs in some rows make tiles unequal in cost.
-            if (i / width) % 7 == 0 {
+            if (i / width).is_multiple_of(7) {
                 [1.0, 1.0, 1.0, 1.0]
             } else {
                 [next() * 1e3, next(), next() * 1e-3, 1.0]
@@ -52,11 +52,7 @@ fn identical_pixels_give_identical_exr_bytes() {
     let back = ocular::image_io::read_exr_rgba(&first).unwrap();
     assert_eq!(back.pixels, image.pixels);
 
-    let depth = ImageGray::new(
-        640,
-        480,
-        image.pixels.iter().map(|p| p[0] + 0.5).collect(),
-    );
+    let depth = ImageGray::new(640, 480, image.pixels.iter().map(|p| p[0] + 0.5).collect());
     let d0 = dir.join("d0.exr");
     write_exr_depth(&d0, &depth).unwrap();
     let reference = std::fs::read(&d0).unwrap();

@@ -23,7 +23,8 @@ fn brute_force_mssim(a: &[[f32; 4]], b: &[[f32; 4]], w: usize, h: usize, r: usiz
     for c in 0..3 {
         for y in r..h - r {
             for x in r..w - r {
-                let (mut sw, mut mx, mut my, mut mxx, mut myy, mut mxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+                let (mut sw, mut mx, mut my, mut mxx, mut myy, mut mxy) =
+                    (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
                 for dy in -(r as i64)..=r as i64 {
                     for dx in -(r as i64)..=r as i64 {
                         let g = (-((dx * dx + dy * dy) as f64) / (2.0 * sigma * sigma)).exp();
@@ -58,7 +59,11 @@ fn identical_narrow_images_have_unit_ssim() {
             "{w}×{h}: MSSIM {} of an image with itself",
             s.mean
         );
-        assert!(s.window_px < 11 && s.window_px <= w.min(h), "{w}×{h}: window {}", s.window_px);
+        assert!(
+            s.window_px < 11 && s.window_px <= w.min(h),
+            "{w}×{h}: window {}",
+            s.window_px
+        );
     }
     let a = image(64, 48, |x, y, _| ((x + y) % 3) as f32 / 3.0);
     assert_eq!(

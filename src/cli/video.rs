@@ -385,10 +385,9 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         count,
         sweep,
     };
-    let (width, height) = args.size.unwrap_or((
-        timeline.scene.resolution[0],
-        timeline.scene.resolution[1],
-    ));
+    let (width, height) = args
+        .size
+        .unwrap_or((timeline.scene.resolution[0], timeline.scene.resolution[1]));
     let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let splat = SplatSettings::default();
     let config = ExportConfig {
@@ -586,7 +585,10 @@ fn host_name() -> String {
     std::fs::read_to_string("/proc/sys/kernel/hostname")
         .ok()
         .or_else(|| std::env::var("HOSTNAME").ok())
-        .map(|h| h.trim().replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_"))
+        .map(|h| {
+            h.trim()
+                .replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_")
+        })
         .filter(|h| !h.is_empty())
         .unwrap_or_else(|| "host".to_string())
 }
@@ -621,9 +623,8 @@ fn write_frame(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
 fn remove_stale_temporaries(dir: &Path) {
     let host = host_name();
     // Without /proc a process cannot be looked up: only age decides.
-    let alive = |pid: u32| {
-        !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists()
-    };
+    let alive =
+        |pid: u32| !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists();
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };

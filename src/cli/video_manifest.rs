@@ -99,10 +99,7 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
         field(
             ah != bh,
             if a == b {
-                format!(
-                    "{option} {}: the eye's content changed",
-                    shown(&b.cloned())
-                )
+                format!("{option} {}: the eye's content changed", shown(&b.cloned()))
             } else {
                 format!(
                     "{option} {} there, {} here",
@@ -173,7 +170,9 @@ pub fn is_frame_name(name: &str) -> bool {
     let Some((digits, ext)) = rest.split_once('.') else {
         return false;
     };
-    digits.len() >= 6 && digits.bytes().all(|b| b.is_ascii_digit()) && (ext == "png" || ext == "exr")
+    digits.len() >= 6
+        && digits.bytes().all(|b| b.is_ascii_digit())
+        && (ext == "png" || ext == "exr")
 }
 
 fn frame_files(dir: &Path) -> Vec<PathBuf> {
@@ -234,9 +233,8 @@ pub fn open(dir: &Path, config: &ExportConfig, overwrite: bool) -> Result<usize>
             ));
         }
         if publish_exclusive(&manifest_path, text.as_bytes())? {
-            std::fs::create_dir_all(dir.join(SUMS_DIR)).map_err(|e| {
-                Error::file(dir.join(SUMS_DIR), format!("cannot create: {e}"))
-            })?;
+            std::fs::create_dir_all(dir.join(SUMS_DIR))
+                .map_err(|e| Error::file(dir.join(SUMS_DIR), format!("cannot create: {e}")))?;
             return Ok(removed);
         }
         // Another job published it first: fall through and compare.

@@ -408,13 +408,13 @@ fn select(devices: &[DeviceInfo], query: Option<&str>) -> GpuResult<usize> {
                     .position(|d| d.name.to_lowercase().contains(&q_lower)),
             }
             .ok_or_else(|| GpuError::DeviceNotFound {
-                    query: q.to_string(),
-                    available: devices
-                        .iter()
-                        .map(|d| format!("{}: {}", d.index, d.name))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                })?
+                query: q.to_string(),
+                available: devices
+                    .iter()
+                    .map(|d| format!("{}: {}", d.index, d.name))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?
         }
         None => devices
             .iter()
