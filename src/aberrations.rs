@@ -354,15 +354,18 @@ impl ZernikeSet {
             file: file.clone(),
             source,
         })?;
+        // Spreadsheet programs save CSV (and editors sometimes TOML) with a UTF-8 byte-order
+        // mark; it is not part of the first field.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .unwrap_or("")
             .to_ascii_lowercase();
         let mut set = match ext.as_str() {
-            "toml" => Self::from_toml_str(&text, &file)?,
-            "csv" => return Self::from_csv_str(&text, &file, pupil_diameter_mm, wavelength_nm),
-            "abp" => Self::from_abp_str(&text, &file)?,
+            "toml" => Self::from_toml_str(text, &file)?,
+            "csv" => return Self::from_csv_str(text, &file, pupil_diameter_mm, wavelength_nm),
+            "abp" => Self::from_abp_str(text, &file)?,
             _ => {
                 return Err(AberrationError::Invalid {
                     file,

@@ -228,41 +228,62 @@ pub fn read_exr_depth_channel(path: impl AsRef<Path>) -> Result<(ImageGray, Stri
     Ok((raw.image, raw.channel, raw.candidates))
 }
 
-/// Writes linear RGBA as 32-bit float EXR (channels R, G, B, A).
+/// Writes linear RGBA as 32-bit float EXR (channels R, G, B, A). Identical pixels give
+/// identical bytes (see [`exr_rgba_bytes`]).
 pub fn write_exr_rgba(path: impl AsRef<Path>, image: &ImageRgba) -> Result<()> {
-    use exr::prelude::*;
     let path = path.as_ref();
     check_size(path, image.width, image.height, image.pixels.len())?;
+    let bytes = exr_rgba_bytes(image).map_err(|m| file_error(path, m))?;
+    write_bytes_atomic(path, &bytes)
+}
+
+/// The tile layout and compression of ocular's EXRs, with the blocks stored in increasing-y
+/// order: the encoder compresses tiles on several threads, and with the format's "unspecified"
+/// order it stores them as they finish, so identical pixels gave different files.
+fn deterministic_encoding() -> exr::image::Encoding {
+    exr::image::Encoding {
+        line_order: exr::meta::attribute::LineOrder::Increasing,
+        ..exr::image::Encoding::FAST_LOSSLESS
+    }
+}
+
+/// The bytes of a 32-bit float RGBA EXR of `image`: a pure function of the pixels.
+pub fn exr_rgba_bytes(image: &ImageRgba) -> std::result::Result<Vec<u8>, String> {
+    use exr::prelude::*;
+    if image.width == 0 || image.height == 0 {
+        return Err(format!(
+            "cannot write an empty {}×{} image",
+            image.width, image.height
+        ));
+    }
     let width = image.width as usize;
     let channels = SpecificChannels::rgba(|position: Vec2<usize>| {
         let p = image.pixels[position.y() * width + position.x()];
         (p[0], p[1], p[2], p[3])
     });
-    let exr_image = Image::from_channels((width, image.height as usize), channels);
-    write_exr_bytes(path, |cursor| {
-        exr_image
-            .write()
-            .to_buffered(cursor)
-            .map_err(|e| format!("cannot encode EXR: {e}"))
-    })
+    let exr_image = Image::from_encoded_channels(
+        (width, image.height as usize),
+        deterministic_encoding(),
+        channels,
+    );
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    exr_image
+        .write()
+        .to_buffered(&mut cursor)
+        .map_err(|e| format!("cannot encode EXR: {e}"))?;
+    Ok(cursor.into_inner())
 }
 
-/// Encodes in memory (the EXR writer needs `Seek`), then writes the bytes atomically.
-fn write_exr_bytes<F>(path: &Path, encode: F) -> Result<()>
-where
-    F: FnOnce(&mut std::io::Cursor<Vec<u8>>) -> std::result::Result<(), String>,
-{
-    let mut cursor = std::io::Cursor::new(Vec::new());
-    encode(&mut cursor).map_err(|m| file_error(path, m))?;
-    let bytes = cursor.into_inner();
+fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     write_atomic(path, |writer| {
         writer
-            .write_all(&bytes)
+            .write_all(bytes)
             .map_err(|e| format!("cannot write: {e}"))
     })
 }
 
-/// Writes one 32-bit float channel named `channel` (use "Z" for depth, the EXR convention).
+/// Writes one 32-bit float channel named `channel` (use "Z" for depth, the EXR convention);
+/// byte-deterministic like [`write_exr_rgba`].
 pub fn write_exr_gray(path: impl AsRef<Path>, image: &ImageGray, channel: &str) -> Result<()> {
     use exr::prelude::*;
     let path = path.as_ref();
@@ -273,13 +294,17 @@ pub fn write_exr_gray(path: impl AsRef<Path>, image: &ImageGray, channel: &str) 
         .with_pixel_fn(
             |position: Vec2<usize>| (image.pixels[position.y() * width + position.x()],),
         );
-    let exr_image = Image::from_channels((width, image.height as usize), channels);
-    write_exr_bytes(path, |cursor| {
-        exr_image
-            .write()
-            .to_buffered(cursor)
-            .map_err(|e| format!("cannot encode EXR: {e}"))
-    })
+    let exr_image = Image::from_encoded_channels(
+        (width, image.height as usize),
+        deterministic_encoding(),
+        channels,
+    );
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    exr_image
+        .write()
+        .to_buffered(&mut cursor)
+        .map_err(|e| file_error(path, format!("cannot encode EXR: {e}")))?;
+    write_bytes_atomic(path, &cursor.into_inner())
 }
 
 /// Writes depth in metres as a single-channel EXR with the conventional channel name Z.
@@ -289,22 +314,28 @@ pub fn write_exr_depth(path: impl AsRef<Path>, image: &ImageGray) -> Result<()> 
 
 /// Writes an 8-bit sRGB PNG preview of linear RGB (alpha is dropped).
 pub fn write_png(path: impl AsRef<Path>, image: &ImageRgba, tonemap: Tonemap) -> Result<()> {
-    use image::ImageEncoder;
     let path = path.as_ref();
     check_size(path, image.width, image.height, image.pixels.len())?;
-    let mut bytes = Vec::with_capacity(image.pixels.len() * 3);
+    let bytes = png_bytes(image, tonemap).map_err(|m| file_error(path, m))?;
+    write_bytes_atomic(path, &bytes)
+}
+
+/// The bytes of the 8-bit sRGB PNG that [`write_png`] writes.
+pub fn png_bytes(image: &ImageRgba, tonemap: Tonemap) -> std::result::Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let mut rgb8 = Vec::with_capacity(image.pixels.len() * 3);
     for p in &image.pixels {
         let rgb = tonemap.apply([p[0], p[1], p[2]]);
-        bytes.extend(rgb.map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8));
+        rgb8.extend(rgb.map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8));
     }
-    write_atomic(path, |writer| {
-        image::codecs::png::PngEncoder::new(writer)
-            .write_image(
-                &bytes,
-                image.width,
-                image.height,
-                image::ExtendedColorType::Rgb8,
-            )
-            .map_err(|e| format!("cannot encode PNG: {e}"))
-    })
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(
+            &rgb8,
+            image.width,
+            image.height,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| format!("cannot encode PNG: {e}"))?;
+    Ok(out)
 }

@@ -7,9 +7,13 @@
 //! reference code, and what scikit-image's `structural_similarity(gaussian_weights=True,
 //! sigma=1.5, use_sample_covariance=False)` reports after cropping its border. The per-pixel map
 //! extends to the border by mirror reflection (scipy's 'reflect' mode) for display.
+//!
+//! An image with a side under 11 pixels has no valid region for that window: SSIM is then
+//! computed with the largest odd window that fits (σ scaled with it), and `Ssim::window_px`
+//! says which, so a caller can report it rather than print a number on another scale.
 
 /// Radius of the 11×11 window.
-const WINDOW_RADIUS: usize = 5;
+pub const WINDOW_RADIUS: usize = 5;
 const SIGMA: f64 = 1.5;
 const K1: f64 = 0.01;
 const K2: f64 = 0.03;
@@ -72,12 +76,17 @@ pub struct Ssim {
     pub mean: f64,
     pub per_channel: [f64; 3],
     pub map: Vec<f32>,
+    /// Side of the Gaussian window used: 11, or smaller for an image with a side under 11.
+    pub window_px: usize,
 }
 
 pub fn ssim(a: ImageView<'_>, b: ImageView<'_>, data_range: f64) -> Ssim {
     assert_same_size(a, b);
     let (w, h) = (a.width, a.height);
-    let weights = gaussian_window();
+    // The largest window (of at most Wang's 11) whose valid region is not empty.
+    let radius = WINDOW_RADIUS.min(w.min(h).saturating_sub(1) / 2);
+    let sigma = SIGMA * (2 * radius + 1) as f64 / (2 * WINDOW_RADIUS + 1) as f64;
+    let weights = gaussian_window(radius, sigma);
     let c1 = (K1 * data_range).powi(2);
     let c2 = (K2 * data_range).powi(2);
     let mut map = vec![0.0f64; w * h];
@@ -88,7 +97,8 @@ pub fn ssim(a: ImageView<'_>, b: ImageView<'_>, data_range: f64) -> Ssim {
         let xx: Vec<f64> = x.iter().map(|v| v * v).collect();
         let yy: Vec<f64> = y.iter().map(|v| v * v).collect();
         let xy: Vec<f64> = x.iter().zip(&y).map(|(p, q)| p * q).collect();
-        let [mx, my, mxx, myy, mxy] = [&x, &y, &xx, &yy, &xy].map(|v| blur(v, w, h, &weights));
+        let [mx, my, mxx, myy, mxy] =
+            [&x, &y, &xx, &yy, &xy].map(|v| blur(v, w, h, radius, &weights));
         let mut valid_sum = 0.0;
         let mut valid_count = 0usize;
         for row in 0..h {
@@ -101,27 +111,22 @@ pub fn ssim(a: ImageView<'_>, b: ImageView<'_>, data_range: f64) -> Ssim {
                 let s = ((2.0 * ux * uy + c1) * (2.0 * cov + c2))
                     / ((ux * ux + uy * uy + c1) * (vx + vy + c2));
                 map[i] += s / 3.0;
-                let inside = row >= WINDOW_RADIUS
-                    && col >= WINDOW_RADIUS
-                    && row + WINDOW_RADIUS < h
-                    && col + WINDOW_RADIUS < w;
+                let inside = row >= radius && col >= radius && row + radius < h && col + radius < w;
                 if inside {
                     valid_sum += s;
                     valid_count += 1;
                 }
             }
         }
-        // Images smaller than one window have no valid region: fall back to the whole map.
-        *channel_mean = if valid_count > 0 {
-            valid_sum / valid_count as f64
-        } else {
-            (0..w * h).map(|i| map[i] * 3.0).sum::<f64>() / (w * h).max(1) as f64
-        };
+        // The window fits, so the valid region holds at least one pixel (none for an empty
+        // image, whose mean is NaN).
+        *channel_mean = valid_sum / valid_count as f64;
     }
     Ssim {
         mean: per_channel.iter().sum::<f64>() / 3.0,
         per_channel,
         map: map.into_iter().map(|v| v as f32).collect(),
+        window_px: 2 * radius + 1,
     }
 }
 
@@ -136,14 +141,15 @@ fn assert_same_size(a: ImageView<'_>, b: ImageView<'_>) {
     );
 }
 
-fn gaussian_window() -> [f64; 2 * WINDOW_RADIUS + 1] {
-    let mut w = [0.0; 2 * WINDOW_RADIUS + 1];
-    for (i, v) in w.iter_mut().enumerate() {
-        let d = i as f64 - WINDOW_RADIUS as f64;
-        *v = (-d * d / (2.0 * SIGMA * SIGMA)).exp();
-    }
+fn gaussian_window(radius: usize, sigma: f64) -> Vec<f64> {
+    let w: Vec<f64> = (0..=2 * radius)
+        .map(|i| {
+            let d = i as f64 - radius as f64;
+            (-d * d / (2.0 * sigma * sigma)).exp()
+        })
+        .collect();
     let sum: f64 = w.iter().sum();
-    w.map(|v| v / sum)
+    w.into_iter().map(|v| v / sum).collect()
 }
 
 /// Mirror index for scipy's 'reflect' mode (d c b a | a b c d | d c b a).
@@ -161,8 +167,8 @@ fn reflect(i: isize, n: usize) -> usize {
 }
 
 /// Separable Gaussian blur with mirror-reflected borders.
-fn blur(v: &[f64], w: usize, h: usize, weights: &[f64]) -> Vec<f64> {
-    let r = WINDOW_RADIUS as isize;
+fn blur(v: &[f64], w: usize, h: usize, radius: usize, weights: &[f64]) -> Vec<f64> {
+    let r = radius as isize;
     let mut tmp = vec![0.0; w * h];
     for row in 0..h {
         for col in 0..w {
@@ -215,7 +221,8 @@ mod tests {
 
     #[test]
     fn window_is_normalised_and_symmetric() {
-        let w = gaussian_window();
+        let w = gaussian_window(WINDOW_RADIUS, SIGMA);
+        assert_eq!(w.len(), 11);
         assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-15);
         for i in 0..=WINDOW_RADIUS {
             assert_eq!(w[i], w[2 * WINDOW_RADIUS - i]);

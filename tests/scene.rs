@@ -221,7 +221,10 @@ fn malformed_scene_files_name_file_line_and_what_is_allowed() {
 
 #[test]
 fn shipped_scenes_parse_with_the_documented_settings() {
-    assert_eq!(Scene::builtin_names(), ["primitives", "chart", "colonnade"]);
+    assert_eq!(
+        Scene::builtin_names(),
+        ["primitives", "chart", "colonnade", "walk"]
+    );
     for name in Scene::builtin_names() {
         let scene = Scene::load(name).unwrap();
         assert!(scene.geometry.triangle_count() > 0, "{name}");

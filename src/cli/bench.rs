@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use clap::Args;
 
-use super::raster::parse_size;
+use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
@@ -31,7 +31,7 @@ pub struct BenchArgs {
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
     /// Frame size.
-    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "1280x720")]
+    #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "1280x720")]
     pub size: (u32, u32),
     /// Frames rendered before timing starts (shader compilation, caches).
     #[arg(long, default_value_t = 5)]
@@ -45,6 +45,7 @@ pub struct BenchArgs {
     /// Screen tile size: 8, 16 or 32.
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
+    /// Storage of the PSF texture the splatting samples.
     #[arg(long, value_enum, default_value = "rgba16f")]
     pub texture_format: PsfTextureFormat,
     /// Fragment merging: 0 = off, 1 = 2×2, 2 = also 4×4.
@@ -58,6 +59,7 @@ pub struct BenchArgs {
     /// Kernel cache folder (default: the user cache); --no-cache times the precomputation.
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
+    /// Neither read nor write the kernel cache.
     #[arg(long)]
     pub no_cache: bool,
     /// Write the results as JSON.
@@ -138,6 +140,12 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     if args.frames == 0 {
         return Err(Error::input("--frames must be at least 1"));
     }
+    // The report's path is checked before minutes of benchmarking, not after.
+    let mut outputs = super::outputs::Outputs::new();
+    if let Some(path) = &args.json {
+        outputs.add("--json", path, &["json"])?;
+    }
+    outputs.probe()?;
     let splat = super::splat_settings(
         args.tile_size,
         args.texture_format,
@@ -254,7 +262,10 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-        crate::image_io::write_text_atomic(path, &text)?;
+        crate::image_io::write_text_atomic(outputs.temporary(path), &text)?;
+    }
+    outputs.commit()?;
+    if let Some(path) = &args.json {
         println!("wrote {}", path.display());
     }
     Ok(())

@@ -6,7 +6,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::raster::parse_size;
+use super::outputs::Outputs;
+use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
@@ -28,12 +29,14 @@ frame's automatic exposure, clamped to [0, 1] (PSNR with a peak of 1; SSIM with 
 settings; in JSON a PSNR of null means identical images). The ground truth computes one exact PSF per 0.001 D \
 bin and channel, on the CPU: it is slow by design.")]
 pub struct CompareArgs {
+    /// Built-in scene or a scene .toml file (rendered at t = 0).
     #[arg(long, value_name = "NAME|FILE", default_value = "primitives")]
     pub scene: String,
+    /// Eye preset or eye .toml file.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
     /// Frame size.
-    #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "320x180")]
+    #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "320x180")]
     pub size: (u32, u32),
     /// Pupil diameter in mm (default: the scene's, else 5 mm as in the seed paper).
     #[arg(long, value_name = "MM")]
@@ -41,10 +44,13 @@ pub struct CompareArgs {
     /// Depth slices for the slice method.
     #[arg(long, default_value_t = 41)]
     pub slices: usize,
+    /// Splatting tile side in pixels.
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
+    /// Storage of the PSF texture the splatting samples.
     #[arg(long, value_enum, default_value = "rgba16f")]
     pub texture_format: PsfTextureFormat,
+    /// Levels of block merging in the splatting (0 = none).
     #[arg(long, default_value_t = 1)]
     pub merge_levels: u32,
     #[command(flatten)]
@@ -83,8 +89,10 @@ pub struct CompareArgs {
     /// Write truth.png, splat.png, slices.png and the SSIM maps (ssim_splat.png, ssim_slices.png).
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
+    /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
+    /// Neither read nor write the kernel cache.
     #[arg(long)]
     pub no_cache: bool,
 }
@@ -144,6 +152,31 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     if args.slices == 0 {
         return Err(Error::input("--slices must be at least 1"));
     }
+    if !(2..=1024).contains(&args.object_samples) {
+        return Err(Error::input(format!(
+            "--object-samples {} is outside 2 to 1024",
+            args.object_samples
+        )));
+    }
+    // Declared before the outputs so that it is dropped after their temporaries are.
+    let maps_created = match &args.maps {
+        Some(dir) => Some(maps_folder(dir)?),
+        None => None,
+    };
+    let mut outputs = Outputs::new();
+    if let Some(path) = &args.truth_out {
+        outputs.add("--truth-out", path, &["exr"])?;
+    }
+    if let Some(path) = &args.json {
+        outputs.add("--json", path, &["json"])?;
+    }
+    if let Some(dir) = &args.maps {
+        for name in map_names(args.no_slices) {
+            outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
+        }
+    }
+    outputs.probe()?;
+    let truth_in = args.truth_in.as_ref().map(read_truth).transpose()?;
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
@@ -157,6 +190,13 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     options.settings.max_radius_cap = args.rmax_cap;
     options.settings.max_beta_degree = args.beta_degree;
     options.settings.sample_um = args.sample_um;
+    options.settings.validate().map_err(|e| {
+        Error::input(
+            e.replace("max_radius_cap", "--rmax-cap")
+                .replace("max_beta_degree", "--beta-degree")
+                .replace("sample_um", "--sample-um"),
+        )
+    })?;
     let kernels = prepare_kernels(
         &eye,
         &scene_needs(
@@ -181,9 +221,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         fov_y_deg: screen.fov_y_deg,
     };
 
-    let truth = match &args.truth_in {
-        Some(path) => {
-            let image = image_io::read_exr_rgba(path)?;
+    let truth = match (&args.truth_in, truth_in) {
+        (Some(path), Some(image)) => {
             if (image.width, image.height) != (width, height) {
                 return Err(Error::input(format!(
                     "--truth-in {} is {}×{}, the frame is {width}×{height}",
@@ -200,11 +239,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 stats: None,
             }
         }
-        None => renderer.render(&input, eye_state, Method::Reference)?,
+        _ => renderer.render(&input, eye_state, Method::Reference)?,
     };
-    if let Some(path) = &args.truth_out {
-        image_io::write_exr_rgba(path, &ImageRgba::new(width, height, truth.color.clone()))?;
-    }
     // The first splat frame compiles shaders and uploads the kernels: time the second.
     renderer.render(&input, eye_state, Method::Splat)?;
     let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
@@ -222,11 +258,21 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let truth01 = exposed(&truth.color, scale);
     let mut methods = Vec::new();
     let mut maps = Vec::new();
+    let mut window_px = 11;
     let frames: Vec<&RenderedFrame> = [Some(&truth), Some(&splat_frame), slices_frame.as_ref()]
         .into_iter()
         .flatten()
         .collect();
     for frame in frames.iter().copied() {
+        if let Some((count, first)) = non_finite(&frame.color, w) {
+            return Err(Error::input(format!(
+                "the {} image has {count} pixels that are not finite (first at x = {}, y = {}); \
+                 no metric is computed from them",
+                frame.method.name(),
+                first.0,
+                first.1
+            )));
+        }
         let image = exposed(&frame.color, scale);
         let quality = ssim(
             ImageView::new(w, h, &image),
@@ -246,6 +292,12 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             gpu_ms: frame.timings.as_ref().map(|t| t.total_ms()),
         });
         maps.push(quality.map);
+        window_px = quality.window_px;
+    }
+    if window_px != 11 {
+        println!(
+            "note: the frame is under SSIM's 11-pixel window; MSSIM uses a {window_px}×{window_px} window"
+        );
     }
     println!(
         "{} through eye {} at {width}×{height}, focus {focus_d:.3} D, pupil {pupil_mm:.2} mm ({})",
@@ -269,9 +321,13 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             m.method, db, m.mssim, m.seconds, m.speedup_vs_reference
         );
     }
+    if let Some(path) = &args.truth_out {
+        image_io::write_exr_rgba(
+            outputs.temporary(path),
+            &ImageRgba::new(width, height, truth.color.clone()),
+        )?;
+    }
     if let Some(dir) = &args.maps {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| Error::file(dir, format!("cannot create: {e}")))?;
         let shown = Tonemap {
             exposure_ev,
             mode: TonemapMode::Clamp,
@@ -282,7 +338,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 m => m.name(),
             };
             let image = ImageRgba::new(width, height, frame.color.clone());
-            image_io::write_png(dir.join(format!("{name}.png")), &image, shown)?;
+            image_io::write_png(
+                outputs.temporary(&dir.join(format!("{name}.png"))),
+                &image,
+                shown,
+            )?;
         }
         let flat = Tonemap {
             exposure_ev: 0.0,
@@ -295,15 +355,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 .map(|v| [v[0], v[1], v[2], 1.0])
                 .collect();
             image_io::write_png(
-                dir.join(format!("{name}.png")),
+                outputs.temporary(&dir.join(format!("{name}.png"))),
                 &ImageRgba::new(width, height, rgb),
                 flat,
             )?;
         }
-        println!(
-            "wrote images and SSIM maps (1.0 → navy, ≤ 0.9 → red) to {}",
-            dir.display()
-        );
     }
     if let Some(path) = &args.json {
         let report = Report {
@@ -319,8 +375,83 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         };
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-        image_io::write_text_atomic(path, &text)?;
+        image_io::write_text_atomic(outputs.temporary(path), &text)?;
+    }
+    outputs.commit()?;
+    if let Some(mut created) = maps_created {
+        created.keep();
+    }
+    if let Some(dir) = &args.maps {
+        println!(
+            "wrote images and SSIM maps (1.0 → navy, ≤ 0.9 → red) to {}",
+            dir.display()
+        );
+    }
+    for path in [&args.truth_out, &args.json].into_iter().flatten() {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The files `--maps` writes, without extension.
+fn map_names(no_slices: bool) -> Vec<&'static str> {
+    if no_slices {
+        vec!["truth", "splat", "ssim_splat"]
+    } else {
+        vec!["truth", "splat", "slices", "ssim_splat", "ssim_slices"]
+    }
+}
+
+/// A `--maps` folder this run created, removed again (if still empty) unless kept.
+struct CreatedFolder(Option<PathBuf>);
+
+impl CreatedFolder {
+    fn keep(&mut self) {
+        self.0 = None;
+    }
+}
+
+impl Drop for CreatedFolder {
+    fn drop(&mut self) {
+        if let Some(dir) = &self.0 {
+            let _ = std::fs::remove_dir(dir);
+        }
+    }
+}
+
+/// The `--maps` folder: an existing folder, or a new one in an existing folder.
+fn maps_folder(dir: &std::path::Path) -> Result<CreatedFolder> {
+    if dir.is_dir() {
+        return Ok(CreatedFolder(None));
+    }
+    if dir.exists() {
+        return Err(Error::input(format!(
+            "--maps {}: is a file; give a folder",
+            dir.display()
+        )));
+    }
+    std::fs::create_dir(dir)
+        .map_err(|e| Error::input(format!("--maps {}: cannot create it ({e})", dir.display())))?;
+    Ok(CreatedFolder(Some(dir.to_path_buf())))
+}
+
+/// `--truth-in`, refused if any colour value is not finite (metrics of NaN are not numbers).
+fn read_truth(path: &PathBuf) -> Result<ImageRgba> {
+    let image = image_io::read_exr_rgba(path)?;
+    if let Some((count, (x, y))) = non_finite(&image.pixels, image.width as usize) {
+        return Err(Error::input(format!(
+            "--truth-in {}: {count} pixels are not finite (first at x = {x}, y = {y}); a ground \
+             truth must hold finite colour",
+            path.display()
+        )));
+    }
+    Ok(image)
+}
+
+/// How many pixels have a non-finite R, G or B, and the first one's (x, y).
+fn non_finite(pixels: &[[f32; 4]], width: usize) -> Option<(usize, (usize, usize))> {
+    let bad = |p: &[f32; 4]| !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite());
+    let first = pixels.iter().position(bad)?;
+    let count = pixels.iter().filter(|p| bad(p)).count();
+    Some((count, (first % width.max(1), first / width.max(1))))
 }

@@ -20,7 +20,7 @@ struct Report<'a> {
 }
 
 pub fn run(cli: &Cli, args: &DevicesArgs) -> Result<()> {
-    let (devices, selected) = resolve_device(cli.device.as_deref().filter(|d| !d.is_empty()))?;
+    let (devices, selected) = resolve_device(cli.device_query().as_deref())?;
     if args.json {
         let text = serde_json::to_string_pretty(&Report {
             selected,

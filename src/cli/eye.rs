@@ -4,9 +4,10 @@
 use clap::{Args, Subcommand};
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
+use super::outputs::Outputs;
 use super::write_atomic;
 use crate::aberrations::{self, ZernikeSet};
 use crate::eye::estimate::{self, Estimate, Method, Progress, Settings};
@@ -92,8 +93,10 @@ pub struct EstimateArgs {
 pub struct ShowArgs {
     /// Eye file or preset name.
     pub eye: String,
+    /// Wavelength of the derived optics (nm).
     #[arg(long, default_value_t = 555.0)]
     pub wavelength_nm: f64,
+    /// Pupil diameter of the derived optics (mm, 1–9).
     #[arg(long, default_value_t = 5.0)]
     pub pupil_mm: f64,
 }
@@ -102,8 +105,10 @@ pub struct ShowArgs {
 pub struct MeasureArgs {
     /// Eye file or preset name.
     pub eye: String,
+    /// Pupil diameter the wavefront is measured over (mm, 1–9).
     #[arg(long)]
     pub pupil_mm: f64,
+    /// Wavelength of the measurement (nm).
     #[arg(long)]
     pub wavelength_nm: f64,
     /// Distance the eye focuses on, and where the measured object point sits (m or "inf").
@@ -112,6 +117,7 @@ pub struct MeasureArgs {
     /// Highest Zernike order (1–10).
     #[arg(long, default_value_t = 6)]
     pub order: u32,
+    /// Print the measurement as JSON.
     #[arg(long)]
     pub json: bool,
 }
@@ -120,10 +126,13 @@ pub struct MeasureArgs {
 pub struct DrawArgs {
     /// Eye file or preset name.
     pub eye: String,
+    /// Where to write the drawing (SVG).
     #[arg(short = 'o', long, value_name = "EYE.svg")]
     pub output: PathBuf,
+    /// Pupil diameter of the ray bundles (mm, 1–9).
     #[arg(long, default_value_t = 4.0)]
     pub pupil_mm: f64,
+    /// Wavelength the rays are traced at (nm).
     #[arg(long, default_value_t = 555.0)]
     pub wavelength_nm: f64,
     /// Focus distances of the two panels (m or "inf").
@@ -162,6 +171,12 @@ fn check_pupil(p: f64) -> Result<()> {
 
 /// The target wavefront from the options, and a one-line description of its source.
 fn target(a: &EstimateArgs) -> Result<(ZernikeSet, String)> {
+    if !a.terms.is_empty() && a.rx.is_none() {
+        return Err(Error::input(
+            "--term adds higher-order terms to --rx \"S C x A\"; a --zernike file or --preset \
+             gives all its own terms",
+        ));
+    }
     finite_option("pupil-mm", a.pupil_mm)?;
     finite_option("wavelength-nm", a.wavelength_nm)?;
     if let Some(p) = a.pupil_mm {
@@ -236,26 +251,15 @@ fn parse_term(t: &str) -> Result<(u32, i32, f64)> {
 
 fn run_estimate(a: &EstimateArgs) -> Result<()> {
     let (target, command) = target(a)?;
-    for (path, exts) in [
-        (Some(&a.output), &["toml"][..]),
-        (a.json.as_ref(), &["json"][..]),
-        (a.plot.as_ref(), &["svg", "png"][..]),
-    ] {
-        if let Some(p) = path {
-            let ext = p
-                .extension()
-                .and_then(|e| e.to_str())
-                .unwrap_or("")
-                .to_ascii_lowercase();
-            if !exts.contains(&ext.as_str()) {
-                return Err(Error::input(format!(
-                    "{}: extension {ext:?} is not allowed; need .{}",
-                    p.display(),
-                    exts.join(" or .")
-                )));
-            }
-        }
+    let mut outputs = Outputs::new();
+    outputs.add("-o", &a.output, &["toml"])?;
+    if let Some(p) = &a.json {
+        outputs.add("--json", p, &["json"])?;
     }
+    if let Some(p) = &a.plot {
+        outputs.add("--plot", p, &["svg", "png"])?;
+    }
+    outputs.probe()?;
     if !(1..=10).contains(&a.order) {
         return Err(Error::input(format!(
             "--order {} is not allowed; need 1 to 10",
@@ -271,13 +275,18 @@ fn run_estimate(a: &EstimateArgs) -> Result<()> {
         ..Settings::default()
     };
     let cancel = Arc::new(AtomicBool::new(false));
-    // A first Ctrl-C stops the search (the best eye is still written); a second one exits.
-    let _ = signal_hook::flag::register_conditional_shutdown(
-        signal_hook::consts::SIGINT,
-        130,
-        Arc::clone(&cancel),
-    );
-    let _ = signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&cancel));
+    // A first SIGINT or SIGTERM stops the search (the best eye is still written, and the exit
+    // status says which signal cancelled it); a second one exits at once.
+    let interrupted = Arc::new(AtomicBool::new(false));
+    let terminated = Arc::new(AtomicBool::new(false));
+    for (signal, code, flag) in [
+        (signal_hook::consts::SIGINT, 130, &interrupted),
+        (signal_hook::consts::SIGTERM, 143, &terminated),
+    ] {
+        let _ = signal_hook::flag::register_conditional_shutdown(signal, code, Arc::clone(&cancel));
+        let _ = signal_hook::flag::register(signal, Arc::clone(&cancel));
+        let _ = signal_hook::flag::register(signal, Arc::clone(flag));
+    }
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new_spinner();
         b.enable_steady_tick(std::time::Duration::from_millis(200));
@@ -299,7 +308,8 @@ fn run_estimate(a: &EstimateArgs) -> Result<()> {
         estimate::EstimateError::Input(m) => Error::Input(m),
         estimate::EstimateError::Eye(e) => Error::Eye(e),
     })?;
-    write_outputs(a, &est, &command)?;
+    write_outputs(a, &est, &command, &outputs)?;
+    outputs.commit()?;
     let r = &est.report;
     if a.print_json {
         println!("{}", json(r)?);
@@ -326,6 +336,21 @@ fn run_estimate(a: &EstimateArgs) -> Result<()> {
             }
         );
     }
+    // A cancelled fit is not a converged one: the status says so (128 + the signal number).
+    let signalled = if interrupted.load(Ordering::SeqCst) {
+        Some(("SIGINT", 130))
+    } else if terminated.load(Ordering::SeqCst) {
+        Some(("SIGTERM", 143))
+    } else {
+        None
+    };
+    if let Some((name, code)) = signalled {
+        eprintln!(
+            "cancelled by {name}: wrote the best eye so far, marked not converged, to {}",
+            a.output.display()
+        );
+        std::process::exit(code);
+    }
     Ok(())
 }
 
@@ -333,7 +358,7 @@ fn json<T: serde::Serialize>(v: &T) -> Result<String> {
     serde_json::to_string_pretty(v).map_err(|e| Error::input(format!("cannot encode JSON: {e}")))
 }
 
-fn write_outputs(a: &EstimateArgs, est: &Estimate, command: &str) -> Result<()> {
+fn write_outputs(a: &EstimateArgs, est: &Estimate, command: &str, outputs: &Outputs) -> Result<()> {
     let r = &est.report;
     let header = format!(
         "Eye estimated by ocular {} from a {} mm, {} nm wavefront.\n\
@@ -359,7 +384,7 @@ fn write_outputs(a: &EstimateArgs, est: &Estimate, command: &str) -> Result<()> 
         } else {
             super::eye_plot::svg(&r.terms, r).into_bytes()
         };
-        write_atomic(p, &bytes)?;
+        write_atomic(outputs.temporary(p), &bytes)?;
     }
     if let Some(p) = &a.json {
         #[derive(serde::Serialize)]
@@ -371,9 +396,9 @@ fn write_outputs(a: &EstimateArgs, est: &Estimate, command: &str) -> Result<()> 
             eye: &est.eye,
             estimate: r,
         })?;
-        write_atomic(p, t.as_bytes())?;
+        write_atomic(outputs.temporary(p), t.as_bytes())?;
     }
-    write_atomic(&a.output, text.as_bytes())
+    write_atomic(outputs.temporary(&a.output), text.as_bytes())
 }
 
 fn run_show(a: &ShowArgs) -> Result<()> {
@@ -526,12 +551,27 @@ fn run_list() -> Result<()> {
     for name in aberrations::preset_names() {
         let s = aberrations::preset(name)?;
         println!(
-            "  {name:<12} {} mm pupil, {} nm, {} terms up to order {}",
+            "  {name:<12} {} mm pupil, {} nm, {}",
             s.pupil_diameter_mm,
             s.wavelength_nm,
-            s.coefficients.len(),
-            s.max_order()
+            describe_terms(&s)
         );
     }
     Ok(())
+}
+
+/// "aberration-free", "1 term of order 2", "27 terms up to order 6": piston changes no image,
+/// so a set of piston alone is described as free of aberration.
+fn describe_terms(set: &ZernikeSet) -> String {
+    let terms: Vec<_> = set
+        .coefficients
+        .iter()
+        .filter(|&&(n, _, um)| n > 0 && um != 0.0)
+        .collect();
+    let order = terms.iter().map(|t| t.0).max().unwrap_or(0);
+    match terms.len() {
+        0 => "aberration-free (piston only)".to_string(),
+        1 => format!("1 term, of order {order}"),
+        k => format!("{k} terms up to order {order}"),
+    }
 }

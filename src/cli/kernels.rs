@@ -175,6 +175,15 @@ struct Summary<'a> {
 }
 
 pub fn run(args: &KernelsArgs) -> Result<()> {
+    let mut outputs = super::outputs::Outputs::new();
+    outputs.add("-o", &args.output, &[])?;
+    if let Some(p) = &args.preview {
+        outputs.add("--preview", p, &["png"])?;
+    }
+    if let Some(p) = &args.plot {
+        outputs.add("--plot", p, &["png"])?;
+    }
+    outputs.probe()?;
     let eye = load_eye(&args.eye)?;
     let mut axes = GridAxes::default();
     if let Some(text) = &args.wavelengths_nm {
@@ -251,13 +260,14 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         CacheOutcome::WriteFailed(w) => eprintln!("warning: {w}"),
         _ => {}
     }
-    write_grid(&args.output, &grid, &key)?;
+    write_grid(outputs.temporary(&args.output), &grid, &key)?;
     if let Some(p) = &args.preview {
-        preview::write_png(p, &preview::contact_sheet(&grid))?;
+        preview::write_png(outputs.temporary(p), &preview::contact_sheet(&grid))?;
     }
     if let Some(p) = &args.plot {
-        preview::write_png(p, &preview::size_plot(&grid))?;
+        preview::write_png(outputs.temporary(p), &preview::size_plot(&grid))?;
     }
+    outputs.commit()?;
     let summary = Summary {
         output: args.output.display().to_string(),
         key,

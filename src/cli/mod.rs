@@ -11,10 +11,13 @@ mod devices;
 mod eye;
 mod eye_plot;
 mod kernels;
+mod outputs;
 mod psf;
 mod raster;
 mod render;
+mod sha256;
 mod video;
+mod video_manifest;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -27,9 +30,10 @@ mod video;
                   tiled PSF splatting (Csoba & Kunkli 2021)."
 )]
 pub struct Cli {
-    /// GPU to use: an index or a name substring as `ocular devices` lists them (default: the
-    /// most capable device; a discrete GPU first, a CPU implementation last).
-    #[arg(long, global = true, env = "OCULAR_DEVICE", value_name = "INDEX|NAME")]
+    /// GPU to use: an index or a name substring as `ocular devices` lists them (default:
+    /// $OCULAR_DEVICE, else the most capable device; a discrete GPU first, a CPU implementation
+    /// last). The CPU-only commands (psf, kernels, eye) refuse it.
+    #[arg(long, global = true, value_name = "INDEX|NAME")]
     pub device: Option<String>,
 
     #[command(subcommand)]
@@ -61,9 +65,30 @@ pub enum Command {
 impl Cli {
     pub fn context_options(&self) -> ContextOptions {
         ContextOptions {
-            device: self.device.clone().filter(|d| !d.is_empty()),
+            device: self.device_query(),
             ..ContextOptions::default()
         }
+    }
+
+    /// `--device`, else `OCULAR_DEVICE`: the environment variable is read here rather than by
+    /// the parser so that `device` holds only what the command line gave.
+    pub fn device_query(&self) -> Option<String> {
+        self.device
+            .clone()
+            .or_else(|| std::env::var("OCULAR_DEVICE").ok())
+            .filter(|d| !d.trim().is_empty())
+    }
+}
+
+/// The commands that compute on the CPU refuse `--device` rather than ignore it. A global
+/// OCULAR_DEVICE is a preference for the GPU commands and is not an error here.
+fn refuse_device(cli: &Cli, command: &str) -> Result<()> {
+    match &cli.device {
+        Some(d) => Err(crate::Error::input(format!(
+            "--device {d}: `ocular {command}` computes on the CPU and uses no GPU; leave \
+             --device out"
+        ))),
+        None => Ok(()),
     }
 }
 
@@ -75,9 +100,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Compare(args) => compare::run(&cli, args),
         Command::Devices(args) => devices::run(&cli, args),
         Command::Raster(args) => raster::run(&cli, args),
-        Command::Psf(args) => psf::run(args),
-        Command::Kernels(args) => kernels::run(args),
-        Command::Eye(args) => eye::run(args),
+        Command::Psf(args) => refuse_device(&cli, "psf").and_then(|()| psf::run(args)),
+        Command::Kernels(args) => refuse_device(&cli, "kernels").and_then(|()| kernels::run(args)),
+        Command::Eye(args) => refuse_device(&cli, "eye").and_then(|()| eye::run(args)),
     }
 }
 

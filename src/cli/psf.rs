@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
+use super::outputs::Outputs;
 use crate::aberrations::{self, ZernikeSet};
 use crate::image_io::{self, ImageGray, ImageRgba, Tonemap, TonemapMode};
 use crate::optics::beta::StilesCrawford;
@@ -23,8 +24,8 @@ Examples:\n  ocular psf --preset keratoconus -o kc.exr --png kc.png\n  \
 ocular psf --zernike eye.abp --pupil-mm 4 --wavelength-nm 550 --defocus-d 1.5 --size 512 -o psf.exr"
 )]
 pub struct PsfArgs {
-    /// Zernike file: our TOML format, CSV (`j,coefficient_um` with `# pupil_mm = …` and
-    /// `# wavelength_nm = …` header lines) or an `.abp` file.
+    /// Zernike file: our TOML format, CSV (`j,coefficient_um` with `# pupil_diameter_mm = …`
+    /// and `# wavelength_nm = …` header lines) or an `.abp` file.
     #[arg(
         long,
         value_name = "FILE",
@@ -135,6 +136,14 @@ fn positive(name: &str, value: f64) -> Result<f64> {
 }
 
 pub fn run(args: &PsfArgs) -> Result<()> {
+    let mut outputs = Outputs::new();
+    outputs.add("-o", &args.output, &["exr"])?;
+    let sidecar_file = sidecar_path(&args.output);
+    outputs.add("-o (its JSON sidecar)", &sidecar_file, &["json"])?;
+    if let Some(png) = &args.png {
+        outputs.add("--png", png, &["png"])?;
+    }
+    outputs.probe()?;
     let (set, source) = load_set(args)?;
     let pupil_mm = positive("--pupil-mm", args.pupil_mm.unwrap_or(set.pupil_diameter_mm))?;
     if pupil_mm > set.pupil_diameter_mm + 1e-9 {
@@ -185,7 +194,7 @@ pub fn run(args: &PsfArgs) -> Result<()> {
         });
     }
     let started = std::time::Instant::now();
-    let psf = compute_psf(&request)?;
+    let psf = compute_psf(&request).map_err(|e| option_error(e, args, pupil_mm, wavelength_nm))?;
     let seconds = started.elapsed().as_secs_f64();
     let total: f64 = psf.intensity.iter().sum();
     if !(total.is_finite() && total > 0.0) {
@@ -203,9 +212,13 @@ pub fn run(args: &PsfArgs) -> Result<()> {
     }
     let normalised: Vec<f32> = psf.intensity.iter().map(|v| (v / total) as f32).collect();
     let n = args.size as u32;
-    image_io::write_exr_gray(&args.output, &ImageGray::new(n, n, normalised.clone()), "Y")?;
+    image_io::write_exr_gray(
+        outputs.temporary(&args.output),
+        &ImageGray::new(n, n, normalised.clone()),
+        "Y",
+    )?;
     if let Some(png) = &args.png {
-        write_log_preview(png, n, &normalised)?;
+        write_log_preview(outputs.temporary(png), n, &normalised)?;
     }
     let sidecar = Sidecar {
         source: &source,
@@ -234,7 +247,8 @@ pub fn run(args: &PsfArgs) -> Result<()> {
     };
     let text = serde_json::to_string_pretty(&sidecar)
         .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-    image_io::write_text_atomic(sidecar_path(&args.output), &text)?;
+    image_io::write_text_atomic(outputs.temporary(&sidecar_file), &text)?;
+    outputs.commit()?;
     if args.json {
         println!("{text}");
     } else {
@@ -252,6 +266,55 @@ pub fn run(args: &PsfArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The optics core names its own quantities (`defocus_f`, `pitch_lambda_over_na`, the grid
+/// extent); the user gave options, so the message names those and their allowed values.
+fn option_error(
+    e: crate::optics::OpticsError,
+    args: &PsfArgs,
+    pupil_mm: f64,
+    wavelength_nm: f64,
+) -> Error {
+    use crate::optics::OpticsError;
+    let OpticsError::OutOfRange { field, .. } = &e else {
+        return e.into();
+    };
+    let per_dioptre = defocus_f_from_dioptres(1.0, pupil_mm, wavelength_nm).abs();
+    let limit_d = 5000.0 / per_dioptre.max(f64::MIN_POSITIVE);
+    if field.contains("defocus") {
+        Error::input(format!(
+            "--defocus-d {}: with the set's own defocus this is more than a {pupil_mm} mm pupil at \
+             {wavelength_nm} nm allows (|total defocus| up to about {limit_d:.0} D)",
+            args.defocus_d
+        ))
+    } else if field.contains("grid extent") {
+        Error::input(format!(
+            "--size {} with --pitch-arcmin {}: the grid reaches too far from the optical axis for \
+             this pupil and wavelength; lower --size or --pitch-arcmin",
+            args.size, args.pitch_arcmin
+        ))
+    } else if field.contains("pitch") {
+        Error::input(format!(
+            "--pitch-arcmin {} is outside what the computation allows for a {pupil_mm} mm pupil \
+             at {wavelength_nm} nm ({:.2e} to {:.2e} arcmin)",
+            args.pitch_arcmin,
+            arcmin_from_pitch(1e-4, pupil_mm, wavelength_nm),
+            arcmin_from_pitch(1e3, pupil_mm, wavelength_nm)
+        ))
+    } else if field == "max_degree" {
+        Error::input(format!(
+            "--max-degree {} is outside 1 to 300",
+            args.max_degree
+        ))
+    } else if field == "beta_tolerance" {
+        Error::input(format!(
+            "--beta-tolerance {} is outside 1e-14 to 0.5",
+            args.beta_tolerance
+        ))
+    } else {
+        e.into()
+    }
 }
 
 /// `psf.exr` → `psf.json`.

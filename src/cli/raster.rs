@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
+use super::outputs::Outputs;
 use super::Cli;
 use crate::gpu::Context;
 use crate::image_io::{self, Tonemap, TonemapMode};
@@ -24,9 +25,9 @@ pub enum TonemapArg {
     ocular raster --scene my_room.toml --size 640x360 --time 2.5 --png preview.png\n\n\
 Colour is linear Rec.709 RGB whose luminance Y = 0.2126R + 0.7152G + 0.0722B is in cd/m²; \
 depth is the distance along the view direction in metres (32-bit float, channel Z). \
-Built-in scenes: primitives, chart, colonnade (see scenes/README.md for the file format).")]
+Built-in scenes: primitives, chart, colonnade, walk (see scenes/README.md for the file format).")]
 pub struct RasterArgs {
-    /// Built-in scene name (primitives, chart, colonnade) or path to a scene .toml file.
+    /// Built-in scene name (primitives, chart, colonnade, walk) or path to a scene .toml file.
     #[arg(long, value_name = "NAME|FILE")]
     pub scene: String,
 
@@ -73,6 +74,22 @@ pub(crate) fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> 
     Ok((parse(w)?, parse(h)?))
 }
 
+/// Smallest frame side the eye-rendering commands accept: the kernel grid's screen needs at
+/// least 16 pixels of height, and the SSIM window 11 pixels of each side.
+pub const MIN_FRAME_SIDE: u32 = 16;
+
+/// `WxH` for the commands that render through an eye (render, video, compare, bench): the
+/// parser states the limit the renderer enforces.
+pub(crate) fn parse_frame_size(text: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = parse_size(text)?;
+    if w < MIN_FRAME_SIDE || h < MIN_FRAME_SIDE {
+        return Err(format!(
+            "\"{text}\": frames through an eye are {MIN_FRAME_SIDE} to 16384 pixels on each side"
+        ));
+    }
+    Ok((w, h))
+}
+
 pub fn run(cli: &Cli, args: &RasterArgs) -> Result<()> {
     if args.output.is_none() && args.depth_out.is_none() && args.png.is_none() {
         return Err(Error::input(
@@ -82,6 +99,17 @@ pub fn run(cli: &Cli, args: &RasterArgs) -> Result<()> {
     if !args.time.is_finite() {
         return Err(Error::input("--time must be a finite number of seconds"));
     }
+    let mut outputs = Outputs::new();
+    if let Some(path) = &args.output {
+        outputs.add("-o", path, &["exr"])?;
+    }
+    if let Some(path) = &args.depth_out {
+        outputs.add("--depth-out", path, &["exr"])?;
+    }
+    if let Some(path) = &args.png {
+        outputs.add("--png", path, &["png"])?;
+    }
+    outputs.probe()?;
     let started = std::time::Instant::now();
     let scene = Scene::load(&args.scene)?;
     let loaded_s = started.elapsed().as_secs_f64();
@@ -96,13 +124,14 @@ pub fn run(cli: &Cli, args: &RasterArgs) -> Result<()> {
     let render_s = render_started.elapsed().as_secs_f64();
 
     let color = frame.color_image();
+    let mut wrote = Vec::new();
     if let Some(path) = &args.output {
-        image_io::write_exr_rgba(path, &color)?;
-        println!("wrote {} (linear RGB, cd/m²)", path.display());
+        image_io::write_exr_rgba(outputs.temporary(path), &color)?;
+        wrote.push(format!("wrote {} (linear RGB, cd/m²)", path.display()));
     }
     if let Some(path) = &args.depth_out {
-        image_io::write_exr_depth(path, &frame.depth_image())?;
-        println!("wrote {} (depth, m)", path.display());
+        image_io::write_exr_depth(outputs.temporary(path), &frame.depth_image())?;
+        wrote.push(format!("wrote {} (depth, m)", path.display()));
     }
     if let Some(path) = &args.png {
         let tonemap = Tonemap {
@@ -114,12 +143,16 @@ pub fn run(cli: &Cli, args: &RasterArgs) -> Result<()> {
                 TonemapArg::Reinhard => TonemapMode::Reinhard,
             },
         };
-        image_io::write_png(path, &color, tonemap)?;
-        println!(
+        image_io::write_png(outputs.temporary(path), &color, tonemap)?;
+        wrote.push(format!(
             "wrote {} (preview, exposure {:+.2} EV)",
             path.display(),
             tonemap.exposure_ev
-        );
+        ));
+    }
+    outputs.commit()?;
+    for line in wrote {
+        println!("{line}");
     }
     let passes: Vec<String> = frame
         .timings

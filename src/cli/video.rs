@@ -1,20 +1,21 @@
 //! `ocular video`: renders a scene's keyframed animation (or a focus sweep) frame by frame to
 //! numbered PNG or EXR files.
 //!
-//! - Resumable: frames are written to a temporary name and renamed, so a file with a final name
-//!   is complete; a re-run skips those and removes stale temporaries.
+//! - Resumable and trusted: the folder's manifest records everything that determines a frame
+//!   and every frame's SHA-256 (see `video_manifest`); a run with another configuration is
+//!   refused, and a frame is skipped only if its bytes match a recorded digest.
 //! - Splittable: kernels are planned from the whole animation (never from the requested range),
 //!   and every frame's eye state depends only on its own index, so `--frames 0..50` and
-//!   `--frames 50..100` produce byte-identical files to one run over `0..100`.
+//!   `--frames 50..100` produce byte-identical files (PNG and EXR) to one run over `0..100`.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 
-use super::raster::parse_size;
-use super::render::load_eye;
-use super::Cli;
+use super::raster::parse_frame_size;
+use super::video_manifest::{self as manifest, DigestLog, ExportConfig};
+use super::{sha256, Cli};
 use crate::eye::Eye;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
@@ -36,12 +37,14 @@ pub enum FrameFormat {
 
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
-    ocular video --scene colonnade --eye myopia --fps 30 -o frames/ --mp4 walk.mp4\n  \
-    ocular video --scene chart --eye healthy --side-by-side keratoconus -o cmp/\n  \
+    ocular video --scene walk --eye myopia -o frames/ --mp4 walk.mp4\n  \
+    ocular video --scene walk --eye healthy --side-by-side keratoconus -o cmp/\n  \
     ocular video --scene primitives --eye healthy --focus-sweep 0.2..7.5 --duration 4 -o sweep/\n\n\
 Split a long export across machines with --frames A..B (frames A to B−1): each job writes its own \
-files into the same folder, and the union is identical to one run. See the README for Slurm, GNU \
-parallel and Kubernetes recipes.")]
+files into the same folder, and the union is identical to one run. The folder's ocular-video.json \
+records the configuration: a run with another one is refused unless --overwrite. A frame is \
+skipped only if its bytes match the SHA-256 recorded when it was written (ocular-video.sums/). \
+See the README for Slurm, GNU parallel and Kubernetes recipes.")]
 pub struct VideoArgs {
     /// Built-in scene or a scene .toml file.
     #[arg(long, value_name = "NAME|FILE")]
@@ -64,8 +67,8 @@ pub struct VideoArgs {
     /// Frame file format.
     #[arg(long, value_enum, default_value = "png")]
     pub format: FrameFormat,
-    /// Frame size (default 640x360).
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    /// Frame size (default: the scene's `resolution`).
+    #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
     /// Render every frame through this second eye as well, side by side and labelled.
     #[arg(long, value_name = "NAME|FILE")]
@@ -88,8 +91,13 @@ pub struct VideoArgs {
     /// Kernel cache folder; --no-cache disables it.
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
+    /// Neither read nor write the kernel cache.
     #[arg(long)]
     pub no_cache: bool,
+    /// Replace an export of another configuration in the folder: its manifest, digests and
+    /// frames are removed first (not for split jobs running at the same time).
+    #[arg(long)]
+    pub overwrite: bool,
 }
 
 /// Parses `A..B`, `A..`, `..B` or `A` into a half-open range within `0..total`.
@@ -222,6 +230,89 @@ fn planning_frames(count: usize) -> Vec<usize> {
     (0..MAX).map(|k| k * (count - 1) / (MAX - 1)).collect()
 }
 
+/// An eye for `option` (`--eye` or `--side-by-side`), with errors naming that option.
+fn load_eye_for(option: &str, spec: &str) -> Result<Eye> {
+    match crate::eye::file::resolve(spec) {
+        Ok(file) => Ok(file.eye),
+        Err(Error::Input(message)) => Err(Error::Input(format!("{option}: {message}"))),
+        Err(other) => Err(other),
+    }
+}
+
+fn sha256_of_debug(values: &[&dyn std::fmt::Debug]) -> String {
+    use std::fmt::Write;
+    let mut h = sha256::Sha256::default();
+    for v in values {
+        // Writing into the hasher cannot fail.
+        let _ = write!(h, "{v:?}\u{1f}");
+    }
+    h.finish_hex()
+}
+
+/// The scene as this export sees it: its geometry, lights and background, and its state at
+/// every frame time (so a changed keyframe or a moved OBJ vertex changes the hash).
+fn scene_sha256(timeline: &Timeline) -> String {
+    use std::fmt::Write;
+    let scene = &timeline.scene;
+    let mut h = sha256::Sha256::default();
+    let _ = write!(
+        h,
+        "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        scene.geometry,
+        scene.lights,
+        scene.background_rgb,
+        scene.base_camera,
+        scene.focus_dpt,
+        scene.pupil_mm,
+        scene.luminance_cd_m2
+    );
+    for i in 0..timeline.count {
+        let state = timeline.state(i);
+        let _ = write!(
+            h,
+            "|{:?}{:?}{:?}{:?}{:?}",
+            state.camera,
+            state.focus_m,
+            state.pupil_mm,
+            state.luminance_cd_m2,
+            timeline.focus_d(i, &state)
+        );
+    }
+    h.finish_hex()
+}
+
+fn eye_sha256(eye: &Eye) -> Result<String> {
+    serde_json::to_string(eye)
+        .map(|text| sha256::hex(text.as_bytes()))
+        .map_err(|e| Error::input(format!("cannot encode the eye: {e}")))
+}
+
+/// `--mp4` is checked before any frame is rendered: ffmpeg, the extension, the folder.
+fn check_mp4(args: &VideoArgs) -> Result<()> {
+    let Some(mp4) = &args.mp4 else {
+        return Ok(());
+    };
+    if args.format != FrameFormat::Png {
+        return Err(Error::input("--mp4 needs --format png frames"));
+    }
+    super::outputs::check_extension("--mp4", mp4, &["mp4"])?;
+    super::outputs::check_folder("--mp4", mp4)?;
+    if !ffmpeg_on_path() {
+        return Err(Error::input(format!(
+            "--mp4 {}: ffmpeg is not on PATH (Debian/Ubuntu: apt-get install ffmpeg); nothing \
+             was rendered",
+            mp4.display()
+        )));
+    }
+    Ok(())
+}
+
+fn ffmpeg_on_path() -> bool {
+    std::env::var_os("PATH")
+        .map(|paths| std::env::split_paths(&paths).any(|p| p.join("ffmpeg").is_file()))
+        .unwrap_or(false)
+}
+
 pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(Error::input(format!(
@@ -234,9 +325,19 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             return Err(Error::input(format!("--pupil-mm {p} is outside 1–9 mm")));
         }
     }
-    if args.mp4.is_some() && args.format != FrameFormat::Png {
-        return Err(Error::input("--mp4 needs --format png frames"));
+    if let Some(ev) = args.exposure {
+        if !ev.is_finite() {
+            return Err(Error::input(format!(
+                "--exposure {ev} must be a finite number of stops"
+            )));
+        }
+        if args.format == FrameFormat::Exr {
+            return Err(Error::input(
+                "--exposure applies to PNG frames only; EXR frames keep linear values",
+            ));
+        }
     }
+    check_mp4(args)?;
     let sweep = args
         .focus_sweep
         .as_deref()
@@ -259,10 +360,16 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         Some(text) => parse_range(text, count).map_err(Error::input)?,
         None => (0, count),
     };
-    let eyes: Vec<(String, Eye)> = std::iter::once(args.eye.clone())
-        .chain(args.side_by_side.clone())
-        .map(|spec| load_eye(&spec).map(|e| (spec, e)))
-        .collect::<Result<_>>()?;
+    let mut eyes: Vec<(String, Eye)> = vec![(args.eye.clone(), load_eye_for("--eye", &args.eye)?)];
+    if let Some(spec) = &args.side_by_side {
+        eyes.push((spec.clone(), load_eye_for("--side-by-side", spec)?));
+    }
+    if args.output.exists() && !args.output.is_dir() {
+        return Err(Error::file(
+            &args.output,
+            "-o names a file; the frames need a folder",
+        ));
+    }
     std::fs::create_dir_all(&args.output).map_err(|e| {
         Error::file(
             &args.output,
@@ -278,8 +385,69 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         count,
         sweep,
     };
+    let (width, height) = args
+        .size
+        .unwrap_or((timeline.scene.resolution[0], timeline.scene.resolution[1]));
+    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let splat = SplatSettings::default();
+    let config = ExportConfig {
+        ocular_version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: args.scene.clone(),
+        scene_sha256: scene_sha256(&timeline),
+        eye: args.eye.clone(),
+        eye_sha256: eye_sha256(&eyes[0].1)?,
+        side_by_side: args.side_by_side.clone(),
+        side_by_side_sha256: eyes.get(1).map(|(_, e)| eye_sha256(e)).transpose()?,
+        size: [width, height],
+        fps: args.fps,
+        frame_count: count,
+        format: match args.format {
+            FrameFormat::Png => "png".to_string(),
+            FrameFormat::Exr => "exr".to_string(),
+        },
+        focus_sweep_m: sweep.map(|(a, b)| [a, b]),
+        pupil_mm: args.pupil_mm,
+        exposure_ev: args.exposure,
+        settings_sha256: sha256_of_debug(&[
+            &options.settings,
+            &options.reference_axes,
+            &splat,
+            &planning_frames(count),
+        ]),
+    };
+    let removed = manifest::open(&args.output, &config, args.overwrite)?;
+    if removed > 0 {
+        eprintln!(
+            "--overwrite: removed {removed} frames of the previous export in {}",
+            args.output.display()
+        );
+    }
+    // Which frames of the range are already there and intact; the rest are rendered.
+    let digests = manifest::recorded_digests(&args.output);
+    let mut todo = Vec::new();
+    let mut rejected = 0usize;
+    for i in first..end {
+        let name = frame_name(i, args.format);
+        let path = args.output.join(&name);
+        if path.exists() {
+            if manifest::verified(&path, digests.get(&name)) {
+                continue;
+            }
+            rejected += 1;
+        }
+        todo.push(i);
+    }
+    if rejected > 0 {
+        eprintln!(
+            "note: {rejected} frame files in {} do not match their recorded SHA-256 (damaged, \
+             or never recorded): rendering them again",
+            args.output.display()
+        );
+    }
+    let skipped = (end - first) - todo.len();
+    let mut log = DigestLog::create(&args.output)?;
+
     let ctx = Context::new(&cli.context_options())?;
-    let (width, height) = args.size.unwrap_or((640, 360));
     let mut rasterizer = Rasterizer::new(&ctx)?;
     let fov_y_deg = timeline.state(0).camera.fov_y_deg;
     let screen = Screen {
@@ -291,45 +459,44 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     let mut ranges = Vec::new();
     let mut states = Vec::new();
     let mut exposure_ev = args.exposure;
-    for i in planning_frames(count) {
-        let state = timeline.state(i);
-        let frame = rasterizer.render(&ctx, &state, width, height)?;
-        if exposure_ev.is_none() {
-            exposure_ev = Some(Tonemap::auto_exposure_ev(&ImageRgba::new(
+    if !todo.is_empty() {
+        for i in planning_frames(count) {
+            let state = timeline.state(i);
+            let frame = rasterizer.render(&ctx, &state, width, height)?;
+            if exposure_ev.is_none() {
+                exposure_ev = Some(Tonemap::auto_exposure_ev(&ImageRgba::new(
+                    width,
+                    height,
+                    frame.color.clone(),
+                )));
+            }
+            ranges.push(dioptre_range(
+                &frame.depth_m,
                 width,
                 height,
-                frame.color.clone(),
-            )));
+                state.camera.fov_y_deg,
+            ));
+            states.push(EyeState {
+                focus_d: timeline.focus_d(i, &state),
+                pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
+            });
         }
-        ranges.push(dioptre_range(
-            &frame.depth_m,
-            width,
-            height,
-            state.camera.fov_y_deg,
-        ));
-        states.push(EyeState {
-            focus_d: timeline.focus_d(i, &state),
-            pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
-        });
     }
-    let needs = scene_needs(&ranges, &states, screen);
-    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     let mut renderers = Vec::new();
-    for (_, eye) in &eyes {
-        let kernels = prepare_kernels(eye, &needs, &options)?;
-        renderers.push(FrameRenderer::new(
-            &ctx,
-            eye.clone(),
-            kernels,
-            options.settings.clone(),
-            SplatSettings::default(),
-        ));
+    if !todo.is_empty() {
+        let needs = scene_needs(&ranges, &states, screen);
+        for (_, eye) in &eyes {
+            let kernels = prepare_kernels(eye, &needs, &options)?;
+            renderers.push(FrameRenderer::new(
+                &ctx,
+                eye.clone(),
+                kernels,
+                options.settings.clone(),
+                splat,
+            ));
+        }
     }
 
-    let todo: Vec<usize> = (first..end)
-        .filter(|&i| !args.output.join(frame_name(i, args.format)).exists())
-        .collect();
-    let skipped = (end - first) - todo.len();
     let bar = progress_bar(todo.len() as u64);
     let started = Instant::now();
     for &i in &todo {
@@ -361,24 +528,29 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
                 None
             },
         );
-        let path = args.output.join(frame_name(i, args.format));
-        match args.format {
-            FrameFormat::Png => image_io::write_png(
-                &path,
+        let name = frame_name(i, args.format);
+        let path = args.output.join(&name);
+        let bytes = match args.format {
+            FrameFormat::Png => image_io::png_bytes(
                 &image,
                 Tonemap {
                     exposure_ev: exposure_ev.unwrap_or(0.0),
                     mode: TonemapMode::Clamp,
                 },
-            )?,
-            FrameFormat::Exr => image_io::write_exr_rgba(&path, &image)?,
+            ),
+            FrameFormat::Exr => image_io::exr_rgba_bytes(&image),
         }
+        .map_err(|m| Error::file(&path, m))?;
+        // The digest is durable before the frame has its final name, so every frame a later
+        // run finds under a final name can be verified.
+        log.record(&name, &bytes)?;
+        write_frame(&args.output, &name, &bytes)?;
         bar.inc(1);
     }
     bar.finish_and_clear();
     let seconds = started.elapsed().as_secs_f64();
     println!(
-        "frames {first}..{end} of {count}: rendered {}, skipped {skipped} already complete, in {seconds:.1} s ({:.2} frames/s) → {}",
+        "frames {first}..{end} of {count}: rendered {}, skipped {skipped} already complete (SHA-256 verified), in {seconds:.1} s ({:.2} frames/s) → {}",
         todo.len(),
         todo.len() as f64 / seconds.max(1e-9),
         args.output.display()
@@ -413,14 +585,78 @@ fn probe_writable(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Temporaries left by an interrupted run (`NAME.tmp-PID`) are never valid frames.
+/// This machine's name, so that a job on a shared folder can tell its own machine's
+/// temporaries from those of jobs running elsewhere.
+fn host_name() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| {
+            h.trim()
+                .replace(|c: char| !c.is_ascii_alphanumeric() && c != '-', "_")
+        })
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "host".to_string())
+}
+
+/// Where frame `name` is written before its rename: `NAME.tmp-HOST-PID`.
+fn temporary_name(name: &str) -> String {
+    format!("{name}.tmp-{}-{}", host_name(), std::process::id())
+}
+
+/// Writes a frame through a temporary name, synced, then renamed into place.
+fn write_frame(dir: &Path, name: &str, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let path = dir.join(name);
+    let tmp = dir.join(temporary_name(name));
+    let result = (|| -> std::io::Result<()> {
+        let mut file = std::fs::File::create(&tmp)?;
+        file.write_all(bytes)?;
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&tmp, &path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::file(&path, format!("cannot write the frame: {e}")));
+    }
+    Ok(())
+}
+
+/// Temporaries are never valid frames. Removed: those of this machine whose process is gone,
+/// and any older than an hour (a frame takes seconds to write). A live split job's
+/// temporaries, here or on another machine sharing the folder, are left alone.
 fn remove_stale_temporaries(dir: &Path) {
-    if let Ok(entries) = std::fs::read_dir(dir) {
-        for entry in entries.flatten() {
-            let name = entry.file_name().to_string_lossy().into_owned();
-            if name.starts_with("frame_") && name.contains(".tmp-") {
-                let _ = std::fs::remove_file(entry.path());
-            }
+    let host = host_name();
+    // Without /proc a process cannot be looked up: only age decides.
+    let alive =
+        |pid: u32| !Path::new("/proc/self").exists() || Path::new(&format!("/proc/{pid}")).exists();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some((_, owner)) = name.split_once(".tmp-") else {
+            continue;
+        };
+        if !name.starts_with("frame_") {
+            continue;
+        }
+        let gone = match owner.rsplit_once('-') {
+            Some((h, pid)) if h == host => pid.parse::<u32>().is_ok_and(|pid| !alive(pid)),
+            // Another machine's.
+            Some(_) => false,
+            // The older `NAME.tmp-PID` form.
+            None => owner.parse::<u32>().is_ok_and(|pid| !alive(pid)),
+        };
+        let old = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age.as_secs() > 3600);
+        if gone || old {
+            let _ = std::fs::remove_file(entry.path());
         }
     }
 }
@@ -452,10 +688,7 @@ fn compose(
 }
 
 fn encode_mp4(dir: &Path, fps: f64, mp4: &Path) -> Result<()> {
-    let found = std::env::var_os("PATH")
-        .map(|paths| std::env::split_paths(&paths).any(|p| p.join("ffmpeg").is_file()))
-        .unwrap_or(false);
-    if !found {
+    if !ffmpeg_on_path() {
         return Err(Error::input(format!(
             "--mp4 {}: ffmpeg is not on PATH (Debian/Ubuntu: apt-get install ffmpeg); the frames are in {}",
             mp4.display(),

@@ -399,25 +399,22 @@ fn select(devices: &[DeviceInfo], query: Option<&str>) -> GpuResult<usize> {
     let chosen = match query {
         Some(q) => {
             let q_lower = q.trim().to_lowercase();
-            let by_index = q
-                .trim()
-                .parse::<usize>()
-                .ok()
-                .filter(|&i| i < devices.len());
-            by_index
-                .or_else(|| {
-                    devices
-                        .iter()
-                        .position(|d| d.name.to_lowercase().contains(&q_lower))
-                })
-                .ok_or_else(|| GpuError::DeviceNotFound {
-                    query: q.to_string(),
-                    available: devices
-                        .iter()
-                        .map(|d| format!("{}: {}", d.index, d.name))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                })?
+            // A number is an index and nothing else: "5" must not fall back to a name that
+            // happens to contain the digit (such as "LLVM 15.0.6").
+            match q.trim().parse::<usize>() {
+                Ok(i) => Some(i).filter(|&i| i < devices.len()),
+                Err(_) => devices
+                    .iter()
+                    .position(|d| d.name.to_lowercase().contains(&q_lower)),
+            }
+            .ok_or_else(|| GpuError::DeviceNotFound {
+                query: q.to_string(),
+                available: devices
+                    .iter()
+                    .map(|d| format!("{}: {}", d.index, d.name))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?
         }
         None => devices
             .iter()

@@ -1,12 +1,12 @@
 //! The rasteriser: a scene at one instant → linear HDR colour and metric depth.
 //!
 //! One render pass draws the scene with 4× MSAA into a colour target (resolved by the render
-//! pass to a single-sample RGBA16F image) and a view-depth target (R32F, the distance along
+//! pass to a single-sample RGBA32F image) and a view-depth target (R32F, the distance along
 //! the view direction in metres, written per sample). A compute pass (raster.comp) then
 //! resolves depth with the nearest sample instead of an average, so depth never blends
 //! across an edge. Pixels no object covers get the background colour and depth `far_m`.
-
-use half::f16;
+//! Colour is 32-bit float throughout: values are cd/m², and lamps, the sun and specular
+//! emitters exceed half float's 65504 (a half-float target clipped them silently).
 
 use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
@@ -137,7 +137,7 @@ impl Rasterizer {
         .bindings(&[BindingKind::UniformBuffer, BindingKind::SampledImage])
         .push_constants::<MaterialPush>()
         .samples(MSAA_SAMPLES)
-        .color_target(TexelFormat::Rgba16Float, true)
+        .color_target(TexelFormat::Rgba32Float, true)
         .color_target(TexelFormat::R32Float, false)
         .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
         .build(ctx)?;
@@ -225,7 +225,7 @@ impl Rasterizer {
             "raster colour (MSAA)",
             width,
             height,
-            TexelFormat::Rgba16Float,
+            TexelFormat::Rgba32Float,
             attachment(false, false, MSAA_SAMPLES),
         )?;
         let view_depth_ms = Image::new_2d(
@@ -249,7 +249,7 @@ impl Rasterizer {
             "raster colour",
             width,
             height,
-            TexelFormat::Rgba16Float,
+            TexelFormat::Rgba32Float,
             attachment(false, false, 1),
         )?;
         let framebuffer = self.pipeline.framebuffer(
@@ -352,7 +352,7 @@ impl Rasterizer {
         let color_readback = Buffer::new(
             ctx,
             "raster colour",
-            (pixels * 8) as u64,
+            (pixels * 16) as u64,
             Residency::Readback,
         )?;
 
@@ -424,15 +424,11 @@ impl Rasterizer {
         // Keep the MSAA targets referenced so that nothing reorders their lifetime.
         let _ = (&targets.color_ms, &targets.depth_ms);
 
-        let halves: Vec<f16> = bytemuck::pod_collect_to_vec(
+        let color: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(
             &color_readback
                 .mapped_bytes()
-                .expect("read-back buffers are host-visible")[..pixels * 8],
+                .expect("read-back buffers are host-visible")[..pixels * 16],
         );
-        let color: Vec<[f32; 4]> = halves
-            .chunks_exact(4)
-            .map(|c| [c[0].to_f32(), c[1].to_f32(), c[2].to_f32(), c[3].to_f32()])
-            .collect();
         let depth_m: Vec<f32> = bytemuck::pod_collect_to_vec(
             &depth_readback
                 .mapped_bytes()

@@ -118,10 +118,11 @@ fn next_scene_id() -> u64 {
 }
 
 /// Scenes shipped in the binary: (name, TOML text).
-const BUILTIN: [(&str, &str); 3] = [
+const BUILTIN: [(&str, &str); 4] = [
     ("primitives", include_str!("../../scenes/primitives.toml")),
     ("chart", include_str!("../../scenes/chart.toml")),
     ("colonnade", include_str!("../../scenes/colonnade.toml")),
+    ("walk", include_str!("../../scenes/walk.toml")),
 ];
 
 impl Scene {
