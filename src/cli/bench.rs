@@ -56,6 +56,11 @@ pub struct BenchArgs {
     /// Also time the ground truth and the slice method once each, and print speed ratios.
     #[arg(long)]
     pub compare_methods: bool,
+    /// Also time the same frames through the previous engine and method (the seed paper's
+    /// per-fragment blend and narrow-field geometry, lists planned on the host and the PSF
+    /// texture rebuilt every frame, no early exit) and print the ratio.
+    #[arg(long)]
+    pub baseline: bool,
     /// Kernel cache folder (default: the user cache); --no-cache times the precomputation.
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
@@ -123,7 +128,81 @@ struct Report {
     wall_ms_per_frame: Stat,
     list_entries: u64,
     max_radius_px: u32,
+    /// Per steady-state frame: queue submissions, GPU allocations, host↔device bytes.
+    counters: Counters,
+    baseline: Option<Baseline>,
     methods: Vec<MethodTime>,
+}
+
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+struct Counters {
+    submissions: u32,
+    allocations: u32,
+    upload_bytes: u64,
+    readback_bytes: u64,
+}
+
+#[derive(serde::Serialize)]
+struct Baseline {
+    what: &'static str,
+    wall_ms_per_frame: Stat,
+    gpu_total: Stat,
+    counters: Counters,
+    /// Baseline wall time over this engine's, per frame.
+    speedup: f64,
+}
+
+struct TimedFrames {
+    per_pass: Vec<(String, Vec<f64>)>,
+    totals: Vec<f64>,
+    walls: Vec<f64>,
+    list_entries: u64,
+    counters: Counters,
+}
+
+/// Splats the frame `warmup + frames` times; keeps the timings of the last `frames`.
+fn time_frames(
+    renderer: &mut FrameRenderer,
+    input: &FrameInput<'_>,
+    state: crate::render::frame::EyeState,
+    args: &BenchArgs,
+    bar: &indicatif::ProgressBar,
+) -> Result<TimedFrames> {
+    let mut t = TimedFrames {
+        per_pass: Vec::new(),
+        totals: Vec::with_capacity(args.frames),
+        walls: Vec::with_capacity(args.frames),
+        list_entries: 0,
+        counters: Counters::default(),
+    };
+    for i in 0..args.warmup + args.frames {
+        let started = Instant::now();
+        let out = renderer.render(input, state, Method::Splat)?;
+        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
+        bar.inc(1);
+        if i < args.warmup {
+            continue;
+        }
+        let timings = out.timings.unwrap_or_default();
+        for pass in &timings.passes {
+            match t.per_pass.iter_mut().find(|(n, _)| *n == pass.name) {
+                Some((_, v)) => v.push(pass.ms),
+                None => t.per_pass.push((pass.name.clone(), vec![pass.ms])),
+            }
+        }
+        t.totals.push(timings.total_ms());
+        t.walls.push(wall_ms);
+        if let Some(s) = out.stats {
+            t.list_entries = s.list_entries;
+            t.counters = Counters {
+                submissions: s.submissions,
+                allocations: s.allocations,
+                upload_bytes: s.upload_bytes,
+                readback_bytes: s.readback_bytes,
+            };
+        }
+    }
+    Ok(t)
 }
 
 #[derive(serde::Serialize)]
@@ -186,6 +265,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         seconds_total: kernels.seconds,
     };
     let max_radius_px = kernels.grid.max_radius_px;
+    let baseline_inputs = args.baseline.then(|| (eye.clone(), kernels.clone()));
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = FrameInput {
         width,
@@ -195,31 +275,42 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         fov_y_deg: screen.fov_y_deg,
     };
 
-    let bar = frame_bar((args.warmup + args.frames) as u64);
-    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
-    let mut totals = Vec::with_capacity(args.frames);
-    let mut walls = Vec::with_capacity(args.frames);
-    let mut list_entries = 0;
-    for i in 0..args.warmup + args.frames {
-        let started = Instant::now();
-        let out = renderer.render(&input, eye_state, Method::Splat)?;
-        let wall_ms = started.elapsed().as_secs_f64() * 1e3;
-        bar.inc(1);
-        if i < args.warmup {
-            continue;
-        }
-        let timings = out.timings.unwrap_or_default();
-        for pass in &timings.passes {
-            match per_pass.iter_mut().find(|(n, _)| *n == pass.name) {
-                Some((_, v)) => v.push(pass.ms),
-                None => per_pass.push((pass.name.clone(), vec![pass.ms])),
-            }
-        }
-        totals.push(timings.total_ms());
-        walls.push(wall_ms);
-        list_entries = out.stats.map_or(0, |s| s.list_entries);
-    }
+    let runs = if args.baseline { 2 } else { 1 };
+    let bar = frame_bar((runs * (args.warmup + args.frames)) as u64);
+    let timed = time_frames(&mut renderer, &input, eye_state, args, &bar)?;
+    let baseline = if let Some((eye, kernels)) = baseline_inputs {
+        let old = crate::render::splat::SplatSettings {
+            blend: crate::render::blend::BlendSettings::paper(),
+            saturation_epsilon: 0.0,
+            steady_state: false,
+            ..splat
+        };
+        let mut old_renderer =
+            FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), old);
+        let old_timed = time_frames(&mut old_renderer, &input, eye_state, args, &bar)?;
+        let (new_ms, old_ms) = (
+            stat("wall", &timed.walls).mean_ms,
+            stat("wall", &old_timed.walls).mean_ms,
+        );
+        Some(Baseline {
+            what: "the seed paper's blend and narrow-field geometry, lists planned on the host \
+                   and the PSF texture rebuilt every frame, no early exit",
+            wall_ms_per_frame: stat("wall", &old_timed.walls),
+            gpu_total: stat("total", &old_timed.totals),
+            counters: old_timed.counters,
+            speedup: old_ms / new_ms,
+        })
+    } else {
+        None
+    };
     bar.finish_and_clear();
+    let TimedFrames {
+        per_pass,
+        totals,
+        walls,
+        list_entries,
+        counters,
+    } = timed;
     let splat_total = stat("total", &totals);
     let mut methods = Vec::new();
     if args.compare_methods {
@@ -256,6 +347,8 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         wall_ms_per_frame: stat("wall", &walls),
         list_entries,
         max_radius_px,
+        counters,
+        baseline,
         methods,
     };
     print_table(&report);
@@ -330,6 +423,19 @@ fn print_table(r: &Report) {
         "  {:<22} {:>10.3} {:>10.3} {:>10.3}   (CPU wall, upload and read-back included)",
         "wall per frame", w.mean_ms, w.median_ms, w.p95_ms
     );
+    let c = &r.counters;
+    println!(
+        "  per frame: {} submission(s), {} allocation(s), {} B up, {} B down",
+        c.submissions, c.allocations, c.upload_bytes, c.readback_bytes
+    );
+    if let Some(b) = &r.baseline {
+        println!();
+        println!("baseline: {}", b.what);
+        println!(
+            "  wall per frame {:.3} ms mean ({} submissions, {} allocations): this engine is {:.2}× faster",
+            b.wall_ms_per_frame.mean_ms, b.counters.submissions, b.counters.allocations, b.speedup
+        );
+    }
     if !r.methods.is_empty() {
         println!();
         println!("methods (wall seconds per frame)");

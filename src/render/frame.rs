@@ -70,6 +70,7 @@ impl Default for KernelOptions {
 }
 
 /// Kernels for a set of frames, with how they were obtained.
+#[derive(Clone)]
 pub struct PreparedKernels {
     pub grid: KernelGrid,
     pub plan: Plan,

@@ -110,6 +110,10 @@ pub struct SplatSettings {
     /// The convolution stops walking a tile's list once every pixel's coverage reaches
     /// 1 − ε in every channel (0 = never): what lies behind then adds at most ε of its light.
     pub saturation_epsilon: f32,
+    /// Steady-state frames in one submission with the PSF texture kept while the eye's state
+    /// holds (false: every frame plans its lists and rebuilds the texture, as before; kept as
+    /// the baseline `ocular bench --baseline` measures against).
+    pub steady_state: bool,
 }
 
 impl Default for SplatSettings {
@@ -121,6 +125,7 @@ impl Default for SplatSettings {
             max_list_bytes: 1 << 30,
             blend: BlendSettings::default(),
             saturation_epsilon: DEFAULT_SATURATION_EPSILON,
+            steady_state: true,
         }
     }
 }
@@ -525,6 +530,7 @@ impl Splatter {
         // frames; only the list total comes back, and a frame whose lists outgrew the buffer
         // (or need bands) is rendered again below, in bands.
         let one_submission = !keep_intermediates
+            && self.settings.steady_state
             && self.entries.is_some()
             && self.last_lists.is_some_and(|(_, bands)| bands == 1);
         let mut submissions = 0u32;
