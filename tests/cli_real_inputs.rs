@@ -123,10 +123,13 @@ fn a_blender_multilayer_file_renders_with_its_combined_colour_and_depth() {
         &out,
     );
     let s = json_ok(&o);
-    assert!(
-        (s["focus_d"].as_f64().unwrap() - 1.0 / 3.0).abs() < 1e-6,
-        "{s}"
-    );
+    // Vergence along the pixel's ray: 3 m of view-axis depth at pixel (3, 4) of a 16-px-high,
+    // 30° frame lies 3·√(1 + (u² + v²)/f²) m away (u, v from the image centre, f the focal
+    // length in pixels).
+    let f = 8.0 / 15f64.to_radians().tan();
+    let (u, v) = (3.5 - 8.0, 4.5 - 8.0);
+    let want = 1.0 / (3.0 * (1.0 + (u * u + v * v) / (f * f)).sqrt());
+    assert!((s["focus_d"].as_f64().unwrap() - want).abs() < 1e-6, "{s}");
 
     // With the compositor's layer too: refused, listing both, until one is chosen.
     let both = dir.join("composite.exr");
@@ -246,7 +249,10 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
         &out,
     );
     let s = json_ok(&o);
-    assert!((s["focus_d"].as_f64().unwrap() - 0.4).abs() < 1e-6, "{s}");
+    // The default focus is the centre pixel (8, 8), half a pixel off the axis of a 40° frame.
+    let f = 8.0 / 20f64.to_radians().tan();
+    let want = 0.4 / (1.0 + 0.5 / (f * f)).sqrt();
+    assert!((s["focus_d"].as_f64().unwrap() - want).abs() < 1e-6, "{s}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
