@@ -60,10 +60,12 @@ vec3 local_scale(vec2 center) {
 }
 
 // Radial and tangential shrink for a kernel of radius r: (cos²θ, cos θ) from 1.5 px up,
-// none below 0.5 px (an in-focus kernel keeps its pixel), linear between.
+// none below 0.5 px (an in-focus kernel keeps its pixel), linear between; none where it
+// would move the kernel's edge by less than a quarter pixel (src/render/projection.rs).
 vec2 shrink_for_radius(float cos_theta, float r) {
     float t = clamp(r - 0.5, 0.0, 1.0);
-    return vec2(1.0) + t * (vec2(cos_theta * cos_theta, cos_theta) - vec2(1.0));
+    vec2 c = vec2(1.0) + t * (vec2(cos_theta * cos_theta, cos_theta) - vec2(1.0));
+    return r * (1.0 / c.x - 1.0) < 0.25 ? vec2(1.0) : c;
 }
 
 // Kernel offset of screen offset d; e = radial unit vector, c = (radial, tangential) shrink.
@@ -105,10 +107,18 @@ vec3 level_of_radius(vec3 r) {
 // the centre of a wide frame a kernel stretches by up to 1/cos²θ and is read bilinearly
 // between texels, so it reaches up to (r + 1)/cos²θ, exclusive.
 float fragment_reach(Fragment f) {
-    float r = ceil(max(f.radius.r, max(f.radius.g, f.radius.b)));
-    float c = local_scale(f.center).z;
-    if (c < 1.0) {
-        r = ceil((r + 1.0) / (c * c)) - 1.0;
+    float radius = max(f.radius.r, max(f.radius.g, f.radius.b));
+    float r = ceil(radius);
+    vec3 s = local_scale(f.center);
+    vec2 c = shrink_for_radius(s.z, radius);
+    if (c.x < 1.0) {
+        // Bilinear reads reach one texel past the block: the kernel is non-zero for kernel
+        // offsets inside the square of half-side r + 1. Screen offsets are its image under the
+        // inverse map (1/c_t)·I + (1/c_r − 1/c_t)·e·eᵀ, whose extent along a grid axis is the
+        // largest row sum of its absolute values.
+        float a = 1.0 / c.x - 1.0 / c.y;
+        float along = max(s.x * s.x, s.y * s.y) + abs(s.x * s.y);
+        r = ceil((r + 1.0) * (1.0 / c.y + a * along)) - 1.0;
     }
     return f.size > 1u ? r + 0.5 : r;
 }

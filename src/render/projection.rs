@@ -42,10 +42,34 @@ impl LocalScale {
 
     /// Radial and tangential shrink (kernel pixels per screen pixel) for a kernel of
     /// `radius_px`: (cos²θ, cos θ) from 1.5 px up, (1, 1) below 0.5 px, linear between.
+    /// Where the map would move the kernel's edge by less than a quarter pixel it is not
+    /// applied at all: the frame's centre then costs what a narrow frame does.
     pub fn for_radius(&self, radius_px: f64) -> [f64; 2] {
         let t = (radius_px - 0.5).clamp(0.0, 1.0);
         let c = self.cos_theta;
-        [1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0)]
+        let shrink = [1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0)];
+        if radius_px * (1.0 / shrink[0] - 1.0) < 0.25 {
+            [1.0, 1.0]
+        } else {
+            shrink
+        }
+    }
+
+    /// How far (whole pixels, per screen axis) a kernel of block radius `r` read at the
+    /// local scale can reach. Bilinear reads reach one texel past the block, so the kernel is
+    /// non-zero for kernel offsets inside the square of half-side r + 1; screen offsets are its
+    /// image under the inverse map (1/c_t)·I + (1/c_r − 1/c_t)·e·eᵀ, whose extent along a grid
+    /// axis is the largest row sum of its absolute values.
+    pub fn reach_px(&self, r: u32, radius_px: f64) -> u32 {
+        let [cr, ct] = self.for_radius(radius_px);
+        if cr < 1.0 {
+            let a = 1.0 / cr - 1.0 / ct;
+            let [ex, ey] = self.radial;
+            let along = (ex * ex).max(ey * ey) + (ex * ey).abs();
+            ((f64::from(r) + 1.0) * (1.0 / ct + a * along)).ceil() as u32 - 1
+        } else {
+            r
+        }
     }
 
     /// Kernel offset (centre-scale pixels) of a screen offset `d` (pixels), for a kernel
@@ -64,11 +88,6 @@ impl LocalScale {
     pub fn area_factor(&self, radius_px: f64) -> f64 {
         let [cr, ct] = self.for_radius(radius_px);
         cr * ct
-    }
-
-    /// Largest screen stretch of a kernel offset (radial): 1/cos²θ.
-    pub fn max_stretch(&self) -> f64 {
-        1.0 / (self.cos_theta * self.cos_theta)
     }
 }
 

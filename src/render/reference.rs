@@ -108,12 +108,8 @@ pub fn render_with(
         .iter()
         .zip(&scales)
         .map(|(&b, s)| {
-            let r = (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0) as f64;
-            if s.cos_theta < 1.0 {
-                ((r + 1.0) * s.max_stretch()).ceil() as i64 - 1
-            } else {
-                r as i64
-            }
+            let r = (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0);
+            i64::from(s.reach_px(r, f64::from(r)))
         })
         .collect();
     let max_reach = reach.iter().copied().max().unwrap_or(0);
@@ -173,7 +169,7 @@ pub fn render_with(
                         let r = natural[i];
                         for (ch, p) in pixel.iter_mut().enumerate() {
                             let k = lookup(ch, bins[i]);
-                            let weight = if s.cos_theta < 1.0 && r > 0.5 {
+                            let weight = if s.for_radius(r)[0] < 1.0 {
                                 let [kx, ky] = s.kernel_offset(d, r);
                                 k.sample(kx, ky) * s.area_factor(r) as f32
                             } else {

@@ -161,11 +161,23 @@ pub fn merge_level(
 
 /// Inclusive pixel rectangle a fragment's kernel can reach (square support).
 pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
-    let mut r = f.radius.iter().fold(0.0f32, |a, &b| a.max(b)).ceil();
-    // Off the centre of a wide frame a kernel stretches by up to 1/cos²θ, read bilinearly.
+    let radius = f.radius.iter().fold(0.0f32, |a, &b| a.max(b));
+    let mut r = radius.ceil();
+    // Off the centre of a wide frame a kernel of radius ≥ 0.5 px stretches radially by up to
+    // 1/cos²θ (in full from 1.5 px), read bilinearly.
     let c = frame.cos_theta(f.center[0], f.center[1]);
-    if c < 1.0 {
-        r = ((r + 1.0) / (c * c)).ceil() - 1.0;
+    let t = (radius - 0.5).clamp(0.0, 1.0);
+    let (cr, ct) = (1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0));
+    // No map where it would move the kernel's edge by less than a quarter pixel; else the
+    // extent of the square |k| < r + 1 under the inverse map along the screen axes.
+    if radius * (1.0 / cr - 1.0) >= 0.25 {
+        let u = f.center[0] - 0.5 * frame.width as f32;
+        let v = f.center[1] - 0.5 * frame.height as f32;
+        let rho = (u * u + v * v).sqrt();
+        let (ex, ey) = (u / rho, v / rho);
+        let a = 1.0 / cr - 1.0 / ct;
+        let along = (ex * ex).max(ey * ey) + (ex * ey).abs();
+        r = ((r + 1.0) * (1.0 / ct + a * along)).ceil() - 1.0;
     }
     let reach = if f.size > 1 { r + 0.5 } else { r };
     let x0 = ((f.center[0] - 0.5 - reach).ceil() as i64).max(0);
