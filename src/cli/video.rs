@@ -189,8 +189,9 @@ impl Timeline {
                 dn + (df - dn) * t
             }
             None => {
-                if state.focus_m.is_finite() && state.focus_m > 0.0 {
-                    1.0 / state.focus_m
+                // Far focus distances are infinity (accommodating to 1e-10 D is ill-posed).
+                if state.focus_m > 0.0 {
+                    crate::render::focus::focus_d_of_distance_m(state.focus_m)
                 } else {
                     0.0
                 }
