@@ -1,0 +1,373 @@
+//! Kernels against an independent computation of the eye's pixel-integrated PSF.
+//!
+//! The reference is written for this test and shares none of the kernel pipeline: the
+//! Fraunhofer integral U(x, y) = (1/π)∫∫ P(u, v) e^{i2π(xu + yv)} du dv of the measured pupil
+//! function P = exp(i(2πW/λ + f(u² + v²))) by direct product Gauss–Legendre quadrature over the
+//! disk (v = sin t, so the chord is smooth in t), evaluated at Gauss–Legendre nodes inside each
+//! screen pixel and summed with their weights: the intensity integrated over the pixel's area.
+//! Only the measured wavefront W and the defocus f of the object are taken from the pipeline
+//! (they are its inputs, tested elsewhere against ray tracing).
+//!
+//! Each case compares the exact-kernel path (ground-truth renderer) at the natural radius and
+//! the grid's kernels at the integer radii either side of it (the PSF scaled so that its
+//! natural half-width spans r + ½ px) with the reference at the same pixel scale: centroid,
+//! r80 and every pixel's energy.
+
+use num_complex::Complex64;
+use ocular::eye::Eye;
+use ocular::optics::quadrature::gauss_legendre_01;
+use ocular::optics::zernike::{wavefront, wavefront_gradient};
+use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
+use ocular::psf::defocus::ChannelOptics;
+use ocular::psf::exact::ExactEye;
+use ocular::psf::grid::{compute_grid, no_progress};
+use ocular::psf::kernels::DioptreAxis;
+use rayon::prelude::*;
+use std::f64::consts::PI;
+
+const WL: [f64; 3] = [612.0, 549.0, 464.0];
+
+fn eye(name: &str) -> Eye {
+    ocular::eye::file::resolve(name).expect("shipped eye").eye
+}
+
+/// Gauss–Legendre nodes and weights on [a, b].
+fn gl(n: usize, a: f64, b: f64) -> Vec<(f64, f64)> {
+    let (x, w) = gauss_legendre_01(n);
+    x.iter()
+        .zip(&w)
+        .map(|(x, w)| (a + (b - a) * x, (b - a) * w))
+        .collect()
+}
+
+/// Largest ray displacement of the pupil (λ/NA): |∇(W/λ) + fρ/π| over a fine polar sampling.
+fn ray_extent(alpha_um: &[f64], wavelength_nm: f64, f: f64) -> f64 {
+    let lam = wavelength_nm * 1e-3;
+    let mut e: f64 = 0.0;
+    for i in 0..=60 {
+        let rho = i as f64 / 60.0;
+        for k in 0..120 {
+            let th = 2.0 * PI * k as f64 / 120.0;
+            let (x, y) = (rho * th.cos(), rho * th.sin());
+            let (gx, gy) = wavefront_gradient(alpha_um, x, y);
+            e = e.max((gx / lam + f * x / PI).hypot(gy / lam + f * y / PI));
+        }
+    }
+    e
+}
+
+/// The PSF of a pupil (wavefront `alpha_um` without piston, tilt and defocus; total defocus f)
+/// integrated over the pixels of a (2r+1)² kernel whose pixels are `pixel` λ/NA wide, in
+/// screen orientation (row offset v shows the retinal y = v·pixel: the eye inverts and screen
+/// y points down), normalised to sum 1 over the kernel.
+fn reference_kernel(
+    alpha_um: &[f64],
+    wavelength_nm: f64,
+    f: f64,
+    pixel: f64,
+    radius: u32,
+) -> Vec<f64> {
+    let side = 2 * radius as usize + 1;
+    let half_width = (radius as f64 + 0.5) * pixel;
+    // the phase turns at most 2π(E + X) per unit pupil coordinate: nodes to spare for it
+    let kappa = 2.0 * PI * (ray_extent(alpha_um, wavelength_nm, f) + half_width);
+    let n_pupil = (0.6 * kappa) as usize + 32;
+    // per pixel: the intensity holds up to 2 cycles per λ/NA
+    let s = (4.0 * pixel).ceil() as usize + 8;
+    let inner = gl(s, -0.5, 0.5);
+    let grid = NodeGrid {
+        radius,
+        pixel,
+        offsets: inner.iter().map(|(d, _)| *d).collect(),
+    };
+    let nodes: Vec<(f64, f64)> = (0..side)
+        .flat_map(|i| {
+            let c = i as f64 - radius as f64;
+            inner.iter().map(move |(d, w)| ((c + d) * pixel, *w))
+        })
+        .collect();
+    let lam = wavelength_nm * 1e-3;
+    let ts = gl(n_pupil, -0.5 * PI, 0.5 * PI);
+    let us = gl(n_pupil, -1.0, 1.0);
+    let nx = nodes.len();
+    // per pupil row v: A_v(x) = Σ_u w P(u, v) e^{i2πxu}, then U(x, y) = Σ_v e^{i2πyv} A_v(x)
+    let zero = || vec![Complex64::default(); nx * nx];
+    let u_field: Vec<Complex64> = ts
+        .par_iter()
+        .fold(zero, |mut acc, &(t, wt)| {
+            let (v, chord) = (t.sin(), t.cos());
+            let mut a = vec![Complex64::default(); nx];
+            let mut e = vec![Complex64::default(); nx];
+            for &(s_u, wu) in &us {
+                let u = chord * s_u;
+                let phase = 2.0 * PI * wavefront(alpha_um, u, v) / lam + f * (u * u + v * v);
+                let p = Complex64::from_polar(wt * chord * wu * chord / PI, phase);
+                exponentials(&grid, u, &mut e);
+                for (ai, ei) in a.iter_mut().zip(&e) {
+                    *ai += p * ei;
+                }
+            }
+            exponentials(&grid, v, &mut e);
+            for (row, ej) in acc.chunks_mut(nx).zip(&e) {
+                for (o, ai) in row.iter_mut().zip(&a) {
+                    *o += ej * ai;
+                }
+            }
+            acc
+        })
+        .reduce(zero, |mut acc, r| {
+            acc.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+            acc
+        });
+    // node (x_a, y_b) lies in pixel (a / s, b / s); retinal +y is screen row offset +v
+    let mut k = vec![0.0; side * side];
+    for (b, (_, wy)) in nodes.iter().enumerate() {
+        for (a, (_, wx)) in nodes.iter().enumerate() {
+            k[(b / s) * side + a / s] += u_field[b * nx + a].norm_sqr() * wx * wy;
+        }
+    }
+    let total: f64 = k.iter().sum();
+    k.iter_mut().for_each(|v| *v /= total);
+    k
+}
+
+/// e^{i2π x u} at every node x = (c + d_k)·pixel (pixel centre c, offsets d_k inside it):
+/// the product of one exponential per pixel and one per offset.
+fn exponentials(grid: &NodeGrid, u: f64, out: &mut [Complex64]) {
+    let inner: Vec<Complex64> = grid
+        .offsets
+        .iter()
+        .map(|d| Complex64::from_polar(1.0, 2.0 * PI * d * grid.pixel * u))
+        .collect();
+    for (i, chunk) in out.chunks_mut(inner.len()).enumerate() {
+        let c = i as f64 - grid.radius as f64;
+        let e = Complex64::from_polar(1.0, 2.0 * PI * c * grid.pixel * u);
+        for (o, d) in chunk.iter_mut().zip(&inner) {
+            *o = e * d;
+        }
+    }
+}
+
+/// Gauss–Legendre nodes inside every pixel of a kernel.
+struct NodeGrid {
+    radius: u32,
+    pixel: f64,
+    offsets: Vec<f64>,
+}
+
+/// Centroid (x right, y down, px from the centre) and r80 (px, about the centre: the radius
+/// at which the energy of pixels sorted by distance, each spread over a ring of unit width,
+/// reaches 0.8).
+fn stats(k: &[f64]) -> (f64, f64, f64) {
+    let side = (k.len() as f64).sqrt().round() as usize;
+    let c = (side / 2) as f64;
+    let (mut sx, mut sy) = (0.0, 0.0);
+    let mut by_r: Vec<(f64, f64)> = Vec::new();
+    for (t, v) in k.iter().enumerate() {
+        let (x, y) = ((t % side) as f64 - c, (t / side) as f64 - c);
+        sx += v * x;
+        sy += v * y;
+        by_r.push((x.hypot(y), *v));
+    }
+    by_r.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut acc = 0.0;
+    let mut r80 = 0.0;
+    for (r, v) in by_r {
+        if acc + v >= 0.8 {
+            // the pixel's energy spreads over [r − ½, r + ½] (the centre pixel over [0, ½])
+            let lo = (r - 0.5).max(0.0);
+            let hi = r + 0.5;
+            r80 = lo + (hi - lo) * (0.8 - acc) / v;
+            break;
+        }
+        acc += v;
+    }
+    (sx, sy, r80)
+}
+
+struct Case {
+    eye: &'static str,
+    pupil_mm: f64,
+    focus_d: f64,
+    object_d: f64,
+    channel: usize,
+    screen: Screen,
+}
+
+/// Pixel width in λ/NA at the centre of a pinhole frame (restated here, not the pipeline's).
+fn pixel_lambda_na(screen: &Screen, pupil_mm: f64, wavelength_nm: f64) -> f64 {
+    let rad_per_px = (0.5 * screen.fov_y_deg.to_radians()).tan() / (0.5 * screen.height_px as f64);
+    rad_per_px / (2.0 * wavelength_nm * 1e-9 / (pupil_mm * 1e-3))
+}
+
+fn compare(label: &str, k: &[f64], reference: &[f64], pixel_tol: f64) -> Vec<String> {
+    let (kx, ky, kr) = stats(k);
+    let (rx, ry, rr) = stats(reference);
+    let worst = k
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "{label}: centroid ({kx:+.3}, {ky:+.3}) vs ({rx:+.3}, {ry:+.3}) px, r80 {kr:.3} vs \
+         {rr:.3} px, worst pixel difference {worst:.4}"
+    );
+    let mut bad = Vec::new();
+    if (kx - rx).abs() > 0.05 || (ky - ry).abs() > 0.05 {
+        bad.push(format!("{label}: centroid off by more than 0.05 px"));
+    }
+    if (kr - rr).abs() > (0.05 * rr).max(0.1) {
+        bad.push(format!("{label}: r80 off by more than 5 % (or 0.1 px)"));
+    }
+    if worst > pixel_tol {
+        bad.push(format!("{label}: a pixel is off by {worst:.4} > {pixel_tol}"));
+    }
+    bad
+}
+
+/// Exact-path kernel at the natural radius and grid kernels at the radii either side.
+fn check(case: &Case, pixel_tol: f64) -> Vec<String> {
+    let settings = KernelSettings::default();
+    let e = eye(case.eye);
+    let ex = ExactEye::new(
+        &e,
+        case.pupil_mm,
+        case.focus_d,
+        WL,
+        case.screen,
+        settings.clone(),
+        64,
+    )
+    .unwrap();
+    let ch: &ChannelOptics = &ex.column.channels[case.channel];
+    let f = ch.defocus_f(case.object_d);
+    let wl = WL[case.channel];
+    let w = pixel_lambda_na(&case.screen, case.pupil_mm, wl);
+    let label = format!(
+        "{} {} mm, focus {} D, object {} D, {} nm, {}° / {} px",
+        case.eye,
+        case.pupil_mm,
+        case.focus_d,
+        case.object_d,
+        wl,
+        case.screen.fov_y_deg,
+        case.screen.height_px
+    );
+    let (natural, kernel) = ex.kernel_checked(case.channel, case.object_d).unwrap();
+    let exact: Vec<f64> = kernel.values.iter().map(|v| f64::from(*v)).collect();
+    // the exact kernel has radius ⌈natural⌉ and true-size pixels
+    let reference = reference_kernel(&ch.alpha_um, wl, f, w, kernel.radius);
+    let mut bad = compare(&format!("{label}, exact path"), &exact, &reference, pixel_tol);
+
+    // the grid: one column whose object axis has the case's object as a sample
+    let axes = GridAxes {
+        objects: DioptreAxis::spanning(case.object_d, case.object_d + 0.25, 2),
+        focus_d: vec![case.focus_d],
+        pupils_mm: vec![case.pupil_mm],
+        wavelengths_nm: WL,
+    };
+    let (grid, report) = compute_grid(&e, &axes, &case.screen, &settings, &no_progress).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert!(report.worst_missed_energy <= 1e-3, "{report:?}");
+    let set = &grid.sets[0];
+    let rn = f64::from(set.radius_px[0][case.channel]);
+    assert!((rn - natural).abs() < 1e-3, "grid {rn} vs exact {natural}");
+    let radii = [rn.floor() as u32, rn.ceil() as u32 + u32::from(rn.fract() == 0.0)];
+    for r in radii.into_iter().filter(|&r| r >= 1 && r <= grid.max_radius_px) {
+        let k: Vec<f64> = set
+            .kernel(r, 0)
+            .iter()
+            .map(|t| f64::from(t[case.channel]))
+            .collect();
+        let scaled = w * (rn + 0.5) / (r as f64 + 0.5);
+        let reference = reference_kernel(&ch.alpha_um, wl, f, scaled, r);
+        bad.extend(compare(
+            &format!("{label}, grid radius {r} (natural {rn:.2})"),
+            &k,
+            &reference,
+            pixel_tol,
+        ));
+    }
+    bad
+}
+
+fn run(cases: &[Case], pixel_tol: f64) {
+    let bad: Vec<String> = cases.iter().flat_map(|c| check(c, pixel_tol)).collect();
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+fn screen(fov_y_deg: f64, height_px: u32) -> Screen {
+    Screen {
+        fov_y_deg,
+        height_px,
+    }
+}
+
+/// Several µm of astigmatism at 6 mm: far beyond any affordable β degree.
+#[test]
+fn astigmatism_at_6_mm() {
+    run(
+        &[
+            Case {
+                eye: "astigmatism",
+                pupil_mm: 6.0,
+                focus_d: 0.0,
+                object_d: 7.0,
+                channel: 1,
+                screen: screen(30.0, 181),
+            },
+            Case {
+                eye: "astigmatism",
+                pupil_mm: 6.0,
+                focus_d: 0.0,
+                object_d: 6.0,
+                channel: 2,
+                screen: screen(20.0, 240),
+            },
+        ],
+        0.01,
+    );
+}
+
+/// Keratoconus at 7 mm (coma and trefoil of several µm) and the narrow asymmetric kernel of
+/// a 4 mm pupil at 0.45 m.
+#[test]
+fn keratoconus_at_7_mm_and_narrow() {
+    run(
+        &[
+            Case {
+                eye: "keratoconus",
+                pupil_mm: 7.0,
+                focus_d: 0.0,
+                object_d: 2.0,
+                channel: 1,
+                screen: screen(30.0, 181),
+            },
+            Case {
+                eye: "keratoconus",
+                pupil_mm: 4.0,
+                focus_d: 0.0,
+                object_d: 1.0 / 0.45,
+                channel: 1,
+                screen: screen(30.0, 181),
+            },
+        ],
+        0.01,
+    );
+}
+
+/// Near focus at a large pupil: a diffraction-limited core much smaller than a pixel.
+#[test]
+fn navarro_near_focus_at_6_mm() {
+    run(
+        &[Case {
+            eye: "navarro",
+            pupil_mm: 6.0,
+            focus_d: 0.5,
+            object_d: 0.5,
+            channel: 1,
+            screen: screen(30.0, 181),
+        }],
+        0.01,
+    );
+}
