@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"OCKGRID\0";
 /// Bump whenever the file layout or the numerics that produce the kernels change.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 /// A streaming 64-bit checksum: every 8-byte word goes through an invertible mix, so any
 /// change to one word changes the result.

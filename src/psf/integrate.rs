@@ -234,7 +234,8 @@ mod tests {
                 .sum::<f64>()
         };
         for (radius, scale) in [(3u32, 7.3f64), (10, 2.1), (2, 40.0)] {
-            let b = BoxIntegrator::new(&values, side, scale, 1000, 4096);
+            // bins no larger than a quarter σ (the role a quarter λ/NA plays for a PSF)
+            let b = BoxIntegrator::new(&values, side, scale, 2, 4096);
             let k = b.kernel(radius, scale);
             let s = 2 * radius as usize + 1;
             let mut exact = vec![0.0; s * s];
