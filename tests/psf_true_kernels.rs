@@ -291,8 +291,10 @@ fn check(case: &Case, pixel_tol: f64) -> Vec<String> {
         wavelengths_nm: WL,
     };
     let (grid, report) = compute_grid(&e, &axes, &case.screen, &settings, &no_progress).unwrap();
-    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
-    assert!(report.worst_missed_energy <= 1e-3, "{report:?}");
+    bad.extend(report.warnings.iter().map(|w| format!("grid warning: {w}")));
+    if report.worst_missed_energy > 1e-3 {
+        bad.push(format!("{label}: missed energy {:.2e}", report.worst_missed_energy));
+    }
     let set = &grid.sets[0];
     let rn = f64::from(set.radius_px[0][case.channel]);
     assert!((rn - natural).abs() < 1e-3, "grid {rn} vs exact {natural}");
