@@ -30,13 +30,26 @@ fn settings() -> KernelSettings {
     }
 }
 
-fn run(eye_name: &str, axes: &GridAxes) -> (f64, GridReport) {
+/// CPU seconds this process has used (user + system; Linux /proc), for figures that other
+/// jobs on a shared machine do not inflate.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // fields after the parenthesised command name; utime and stime are the 12th and 13th
+    let rest = stat.rsplit_once(')')?.1;
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+fn run(eye_name: &str, axes: &GridAxes) -> (f64, Option<f64>, GridReport) {
     let eye = resolve(eye_name).expect("eye").eye;
     let t = Instant::now();
+    let c = cpu_seconds();
     let (grid, report) = compute_grid(&eye, axes, &screen(), &settings(), &no_progress).unwrap();
     let s = t.elapsed().as_secs_f64();
+    let cpu = cpu_seconds().zip(c).map(|(b, a)| b - a);
     drop(grid);
-    (s, report)
+    (s, cpu, report)
 }
 
 /// Both methods on a few PSFs of the keratoconus eye whose β expansion converges: measured
@@ -85,8 +98,8 @@ fn main() {
         rayon::current_num_threads(),
         std::env::consts::ARCH
     );
-    println!("| eye | grid | PSFs | by FFT | seconds | optics s | PSFs s | kernels s | Rmax (natural) | MiB per (focus, pupil) | worst missed energy |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| eye | grid | PSFs | by FFT | seconds | CPU s | optics s | PSFs s | kernels s | Rmax (natural) | MiB per (focus, pupil) | worst missed energy |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for eye in ["keratoconus", "myopia-like", "keratoconus-like"] {
         let mut cases = vec![(
             "column, pupil 4 mm, focus 0.125 D",
@@ -108,11 +121,12 @@ fn main() {
             cases.push(("full (paper)", GridAxes::default()));
         }
         for (label, axes) in cases {
-            let (s, r) = run(eye, &axes);
+            let (s, cpu, r) = run(eye, &axes);
             println!(
-                "| {eye} | {label} | {} | {} | {s:.1} | {:.1} | {:.1} | {:.1} | {} ({:.1}) | {:.1} | {:.1e} |",
+                "| {eye} | {label} | {} | {} | {s:.1} | {} | {:.1} | {:.1} | {:.1} | {} ({:.1}) | {:.1} | {:.1e} |",
                 r.psfs_computed,
                 r.psfs_fft,
+                cpu.map_or("n/a".into(), |c| format!("{c:.1}")),
                 r.seconds_optics,
                 r.seconds_psfs,
                 r.seconds_kernels,
@@ -125,6 +139,9 @@ fn main() {
                 println!("warning: {w}");
             }
         }
+    }
+    if let Ok(load) = std::fs::read_to_string("/proc/loadavg") {
+        println!("(load average at the end: {})", load.trim());
     }
     println!(
         "(paper: 196–622 s for the 2460 PSFs on 8 cores; 74 MB per (focus, pupil) pair at Rmax 48)"

@@ -126,7 +126,10 @@ fn csv_pupil_header_spellings() {
     )
     .unwrap_err()
     .to_string();
-    assert!(e.starts_with("w.csv:2:") && e.contains("contradicts"), "{e}");
+    assert!(
+        e.starts_with("w.csv:2:") && e.contains("contradicts"),
+        "{e}"
+    );
     let e = ZernikeSet::from_csv_str("# pupil_mm = wide\n4,1\n", "w.csv", None, Some(555.0))
         .unwrap_err()
         .to_string();

@@ -120,7 +120,11 @@ fn kernels_report_the_missed_pupil_energy_per_column() {
         .arg(dir.join("k.bin"))
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let report = &json["report"];
@@ -134,7 +138,10 @@ fn kernels_report_the_missed_pupil_energy_per_column() {
         .map(|v| v.as_f64().unwrap())
         .collect();
     assert_eq!(missed.len(), 3);
-    assert!(missed.iter().all(|m| (0.0..=1e-3).contains(m)), "{missed:?}");
+    assert!(
+        missed.iter().all(|m| (0.0..=1e-3).contains(m)),
+        "{missed:?}"
+    );
     // where the expansion did not converge, the PSFs were computed by FFT
     let beta: Vec<f64> = column["beta_truncation_error"]
         .as_array()

@@ -170,7 +170,10 @@ fn resampling_integrates_over_pixels() {
                 .zip(&binned)
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
-            assert!(worst < 0.005, "f {f}, radius {radius}: a pixel differs by {worst}");
+            assert!(
+                worst < 0.005,
+                "f {f}, radius {radius}: a pixel differs by {worst}"
+            );
             assert!(
                 (kx - ex).abs() < 0.02 && (ky - ey).abs() < 0.02,
                 "f {f}, radius {radius}: kernel centroid ({kx:.3}, {ky:.3}) vs binned ({ex:.3}, {ey:.3}) px"

@@ -78,7 +78,13 @@ pub fn psf_by_fft(
 ) -> Result<Vec<f64>, OpticsError> {
     super::check_range("pitch", pitch, 1e-4, 1e3, "1e-4 to 1000 lambda/NA")?;
     super::check_range("defocus_f", defocus_f, -1e5, 1e5, "|f| <= 1e5")?;
-    super::check_range("wavelength_nm", wavelength_nm, 350.0, 1100.0, "350 to 1100 nm")?;
+    super::check_range(
+        "wavelength_nm",
+        wavelength_nm,
+        350.0,
+        1100.0,
+        "350 to 1100 nm",
+    )?;
     let (n, du) = fft_layout(pitch, size);
     if n > MAX_FFT_LEN || size % 2 == 0 || size > n {
         return Err(OpticsError::OutOfRange {

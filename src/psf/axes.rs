@@ -218,7 +218,12 @@ impl KernelSettings {
             ("um_per_deg", self.um_per_deg, 100.0, 500.0),
             ("samples_per_2pi", self.samples_per_2pi, 1.0, 64.0),
             ("samples_per_pixel", self.samples_per_pixel, 1.0, 16.0),
-            ("samples_per_lambda_na", self.samples_per_lambda_na, 0.5, 64.0),
+            (
+                "samples_per_lambda_na",
+                self.samples_per_lambda_na,
+                0.5,
+                64.0,
+            ),
             ("energy", self.energy, 0.5, 0.999999),
             ("diffraction_margin", self.diffraction_margin, 0.0, 100.0),
             ("accommodation_nm", self.accommodation_nm, 380.0, 800.0),

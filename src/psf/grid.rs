@@ -8,8 +8,8 @@
 
 use super::axes::{GridAxes, KernelSettings, Screen};
 use super::defocus::ColumnOptics;
-use super::kernels::{kernel_side, KernelGrid, KernelSet};
 use super::integrate::BoxIntegrator;
+use super::kernels::{kernel_side, KernelGrid, KernelSet};
 use super::project::{cropped_psf, PsfMethod, MAX_BINS};
 use crate::eye::Eye;
 use crate::{Error, Result};

@@ -82,7 +82,10 @@ impl BoxIntegrator {
         } else {
             1
         };
-        let bin = by_pixel.min(max_bin).max(1).max(w.div_ceil(max_bins.max(8)));
+        let bin = by_pixel
+            .min(max_bin)
+            .max(1)
+            .max(w.div_ceil(max_bins.max(8)));
         let m = w.div_ceil(bin);
         let mut bins = vec![0.0f64; m * m];
         for q in 0..side {
@@ -249,7 +252,11 @@ mod tests {
             }
             let total: f64 = exact.iter().sum();
             for (a, e) in k.iter().zip(&exact) {
-                assert!((a - e / total).abs() < 2e-4, "r {radius}: {a} vs {}", e / total);
+                assert!(
+                    (a - e / total).abs() < 2e-4,
+                    "r {radius}: {a} vs {}",
+                    e / total
+                );
             }
         }
     }

@@ -210,8 +210,7 @@ pub fn cropped_psf_at_f(
     };
     let (intensity, missed) = match method {
         PsfMethod::Enz => {
-            let mut req =
-                PsfRequest::new(Vec::new(), ch.pupil_mm, ch.wavelength_nm, pitch, size);
+            let mut req = PsfRequest::new(Vec::new(), ch.pupil_mm, ch.wavelength_nm, pitch, size);
             req.include_tilt = false;
             req.radial_tolerance = settings.radial_tolerance;
             req.beta_tolerance = settings.beta_tolerance;
