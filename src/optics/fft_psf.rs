@@ -86,7 +86,7 @@ pub fn psf_by_fft(
         "350 to 1100 nm",
     )?;
     let (n, du) = fft_layout(pitch, size);
-    if n > MAX_FFT_LEN || size % 2 == 0 || size > n {
+    if n > MAX_FFT_LEN || size.is_multiple_of(2) || size > n {
         return Err(OpticsError::OutOfRange {
             field: "FFT grid".into(),
             value: n as f64,
