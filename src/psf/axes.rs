@@ -161,9 +161,10 @@ pub struct KernelSettings {
     /// grid coarser than the screen).
     pub samples_per_pixel: f64,
     /// At least this many PSF samples per λ/NA while the grid stays within
-    /// [`super::project::MAX_PSF_SIDE`]: the intensity holds spatial frequencies up to 2 per
-    /// λ/NA, and the cubic interpolant integrated over each pixel needs about four samples
-    /// per period of the highest one.
+    /// [`super::project::MAX_PSF_SIDE`] and a pixel holds at most
+    /// [`super::project::MAX_SAMPLES_PER_PIXEL`] samples: the intensity holds spatial
+    /// frequencies up to 2 per λ/NA, and the cubic interpolant integrated over each pixel needs
+    /// about four samples per period of the highest one.
     pub samples_per_lambda_na: f64,
     /// How each PSF is computed (see [`MethodChoice`]).
     pub method: MethodChoice,

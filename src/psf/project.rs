@@ -124,12 +124,18 @@ pub fn pitch_lambda_na(ch: &ChannelOptics, screen: &Screen, settings: &KernelSet
         ch.wavelength_nm,
     );
     let per_2pi = 4.0 / settings.samples_per_2pi;
-    let diffraction = 1.0 / settings.samples_per_lambda_na;
+    let pixel = pixel_lambda_na(ch, screen);
+    // the diffraction pitch, but never more than MAX_SAMPLES_PER_PIXEL per pixel: a pixel
+    // that wide averages the intensity's finest ripples out, except at its edges
+    let diffraction = (1.0 / settings.samples_per_lambda_na).max(pixel / MAX_SAMPLES_PER_PIXEL);
     retinal
         .min(per_2pi)
         .min(diffraction)
-        .min(pixel_lambda_na(ch, screen) / settings.samples_per_pixel)
+        .min(pixel / settings.samples_per_pixel)
 }
+
+/// Samples per screen pixel beyond which the diffraction pitch is relaxed.
+pub const MAX_SAMPLES_PER_PIXEL: f64 = 64.0;
 
 /// One screen pixel at the centre of the frame in λ/NA.
 pub fn pixel_lambda_na(ch: &ChannelOptics, screen: &Screen) -> f64 {
