@@ -187,8 +187,8 @@ pub fn enz_cost(degree: u32, size: usize) -> f64 {
 
 /// Calibration of [`enz_cost`] against [`fft_cost`] (measured with `cargo bench --bench
 /// kernels -- --methods` on x86-64).
-const ENZ_PIXEL_UNITS: f64 = 2.5;
-const ENZ_RADIUS_UNITS: f64 = 1.0;
+const ENZ_PIXEL_UNITS: f64 = 5.0;
+const ENZ_RADIUS_UNITS: f64 = 2.0;
 
 /// As [`cropped_psf`] for a given total defocus f. The method is chosen per PSF: the ENZ
 /// series where the channel's β expansion met its tolerance and is the cheaper of the two,
