@@ -17,9 +17,10 @@
 //!
 //! **CSV**, `*.csv`: one `j,coefficient_um` pair per line, j the OSA single index (0 = piston).
 //! Blank lines, lines starting with `#` and everything after a `#` later in a line (an inline
-//! comment) are ignored, except the header lines
-//! `# pupil_diameter_mm = 5.0` and `# wavelength_nm = 550`, which set the pupil and
-//! wavelength. A first line `j,coefficient_um` (any case) is skipped. Pupil and wavelength given
+//! comment) are ignored, except the header lines `# pupil_mm = 5.0` (alias
+//! `# pupil_diameter_mm = 5.0`; both spellings must agree where both appear) and
+//! `# wavelength_nm = 550`, which set the pupil diameter and wavelength. A first line
+//! `j,coefficient_um` (any case) is skipped. Pupil and wavelength given
 //! to [`ZernikeSet::from_csv_str`] / [`ZernikeSet::load`] override the header lines; one of the
 //! two sources must provide each.
 //!
@@ -196,16 +197,27 @@ impl ZernikeSet {
                     let key = k.trim().to_ascii_lowercase();
                     let val: Option<f64> = v.trim().parse().ok();
                     let slot = match key.as_str() {
-                        "pupil_diameter_mm" => Some(&mut pupil),
+                        "pupil_mm" | "pupil_diameter_mm" => Some(&mut pupil),
                         "wavelength_nm" => Some(&mut wl),
                         _ => None,
                     };
                     if let Some(slot) = slot {
-                        *slot = Some(val.ok_or_else(|| AberrationError::Parse {
+                        let val = val.ok_or_else(|| AberrationError::Parse {
                             file: file.into(),
                             line,
                             message: format!("{key} needs a number, got {:?}", v.trim()),
-                        })?);
+                        })?;
+                        if slot.is_some_and(|old| old != val) {
+                            return Err(AberrationError::Parse {
+                                file: file.into(),
+                                line,
+                                message: format!(
+                                    "{key} = {val} contradicts an earlier header line ({})",
+                                    slot.unwrap_or_default()
+                                ),
+                            });
+                        }
+                        *slot = Some(val);
                     }
                 }
                 continue;
@@ -251,7 +263,7 @@ impl ZernikeSet {
             .ok_or_else(|| AberrationError::Invalid {
                 file: file.into(),
                 message:
-                    "pupil diameter not given: add a line '# pupil_diameter_mm = 5.0' or pass it"
+                    "pupil diameter not given: add a line '# pupil_mm = 5.0' (or '# pupil_diameter_mm = 5.0') or pass it"
                         .into(),
             })?;
         let wl = wavelength_nm

@@ -106,6 +106,36 @@ fn csv_format() {
     assert!(e.contains("finite"), "{e}");
 }
 
+/// The README documents `# pupil_mm = …`; `# pupil_diameter_mm = …` stays an alias, and the
+/// two must not disagree.
+#[test]
+fn csv_pupil_header_spellings() {
+    let body = "# wavelength_nm = 555\n4, 0.5\n";
+    for key in ["pupil_mm", "PUPIL_MM", "pupil_diameter_mm"] {
+        let text = format!("# {key} = 6.5\n{body}");
+        let s = ZernikeSet::from_csv_str(&text, "w.csv", None, None).unwrap();
+        assert_eq!(s.pupil_diameter_mm, 6.5, "{key}");
+    }
+    let same = format!("# pupil_mm = 6\n# pupil_diameter_mm = 6\n{body}");
+    assert!(ZernikeSet::from_csv_str(&same, "w.csv", None, None).is_ok());
+    let e = ZernikeSet::from_csv_str(
+        &format!("# pupil_mm = 6\n# pupil_diameter_mm = 5\n{body}"),
+        "w.csv",
+        None,
+        None,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.starts_with("w.csv:2:") && e.contains("contradicts"),
+        "{e}"
+    );
+    let e = ZernikeSet::from_csv_str("# pupil_mm = wide\n4,1\n", "w.csv", None, Some(555.0))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("pupil_mm needs a number"), "{e}");
+}
+
 #[test]
 fn abp_format() {
     // the seed paper's framework format, including a file without a trailing newline

@@ -253,6 +253,11 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         compute_grid(&eye, &axes, &screen, &settings, &progress)
     })?;
     bars.finish();
+    if let Some(r) = &report {
+        for w in &r.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
     match &outcome {
         CacheOutcome::Stored {
             warning: Some(w), ..
@@ -312,7 +317,7 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         if let Some(r) = &report {
             for c in &r.columns {
                 println!(
-                    "  pupil {:.2} mm, focus {:.3} D: lens {:.3} mm{}, residual R/G/B {:+.3} {:+.3} {:+.3} D, beta degree {:?}",
+                    "  pupil {:.2} mm, focus {:.3} D: lens {:.3} mm{}, residual R/G/B {:+.3} {:+.3} {:+.3} D, beta degree {:?}, PSFs by FFT {:?}, missed pupil energy {:.1e} {:.1e} {:.1e}",
                     c.pupil_mm,
                     c.focus_d,
                     c.lens_diameter_mm,
@@ -320,7 +325,11 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
                     c.residual_d[0],
                     c.residual_d[1],
                     c.residual_d[2],
-                    c.beta_degree
+                    c.beta_degree,
+                    c.fft_psfs,
+                    c.missed_energy[0],
+                    c.missed_energy[1],
+                    c.missed_energy[2],
                 );
             }
         }

@@ -457,6 +457,9 @@ struct Summary {
     seconds_kernels: f64,
     kernels_from_cache: bool,
     psfs_computed: usize,
+    /// Worst pupil energy the kernels' PSFs missed, per (pupil, focus) column and channel
+    /// (null when the kernels came from the cache: they were checked when computed).
+    psf_missed_energy: Option<Vec<[f64; 3]>>,
     max_radius_px: u32,
     gpu_ms: Option<Vec<(String, f64)>>,
     gpu_total_ms: Option<f64>,
@@ -537,6 +540,10 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let kernels = prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
     let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
+    let missed = kernels
+        .report
+        .as_ref()
+        .map(|r| r.columns.iter().map(|c| c.missed_energy).collect());
     let seconds_kernels = kernels.seconds;
     let max_radius = kernels.grid.max_radius_px;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
@@ -591,6 +598,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         seconds_kernels,
         kernels_from_cache: from_cache,
         psfs_computed: psfs,
+        psf_missed_energy: missed,
         max_radius_px: max_radius,
         gpu_total_ms: frame.timings.as_ref().map(|t| t.total_ms()),
         gpu_ms: gpu,

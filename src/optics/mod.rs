@@ -5,11 +5,13 @@
 //! - [`quadrature`]: Gauss–Legendre, Fejér (cosine-sampled pupil) rules, a small FFT.
 //! - [`enz`]: V_n^m(r, f) (Bessel–Bessel series, power series, quadrature) and radial tables.
 //! - [`beta`]: ENZ pupil coefficients β from wavefront coefficients α.
+//! - [`fft_psf`]: the PSF by FFT of the sampled pupil function (large aberrations).
 //! - [`psf`]: the high-level PSF entry point ([`psf::PsfRequest`] → [`psf::Psf`]).
 
 pub mod bessel;
 pub mod beta;
 pub mod enz;
+pub mod fft_psf;
 pub mod field;
 pub mod psf;
 pub mod pupil;

@@ -132,6 +132,19 @@ impl Screen {
     }
 }
 
+/// Which method computes the PSFs of the kernels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MethodChoice {
+    /// Per PSF, the cheaper of the two where the β expansion meets its tolerance, else FFT.
+    #[default]
+    Auto,
+    /// Always the ENZ series (whatever the β truncation; for tests and comparisons).
+    Enz,
+    /// Always the transform of the sampled pupil function.
+    Fft,
+}
+
 /// Numerical settings of the precomputation.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct KernelSettings {
@@ -147,6 +160,14 @@ pub struct KernelSettings {
     /// At least this many PSF samples per output pixel (kernels are never upsampled from a
     /// grid coarser than the screen).
     pub samples_per_pixel: f64,
+    /// At least this many PSF samples per λ/NA while the grid stays within
+    /// [`super::project::MAX_PSF_SIDE`] and a pixel holds at most
+    /// [`super::project::MAX_SAMPLES_PER_PIXEL`] samples: the intensity holds spatial
+    /// frequencies up to 2 per λ/NA, and the cubic interpolant integrated over each pixel needs
+    /// about four samples per period of the highest one.
+    pub samples_per_lambda_na: f64,
+    /// How each PSF is computed (see [`MethodChoice`]).
+    pub method: MethodChoice,
     /// Fraction of the computed PSF's energy the cropped square keeps.
     pub energy: f64,
     /// Room around the geometric (ray) extent of the PSF for diffraction, in λ/NA.
@@ -161,7 +182,8 @@ pub struct KernelSettings {
     pub far_point_limit: bool,
     /// Zernike order of the aberration measurement.
     pub zernike_order: u32,
-    /// Allowed pupil energy missed by the β expansion, and its degree cap.
+    /// Pupil energy the β expansion may miss, and its degree cap: a channel whose expansion
+    /// does not meet the tolerance below the cap has its PSFs computed by FFT instead.
     pub beta_tolerance: f64,
     pub max_beta_degree: u32,
     /// Relative accuracy of the ENZ radial tables.
@@ -174,7 +196,9 @@ impl Default for KernelSettings {
             sample_um: 4.0,
             um_per_deg: 288.0,
             samples_per_2pi: 2.0,
-            samples_per_pixel: 2.0,
+            samples_per_pixel: 4.0,
+            samples_per_lambda_na: 8.0,
+            method: MethodChoice::Auto,
             energy: 0.999,
             diffraction_margin: 4.0,
             max_radius_cap: 64,
@@ -182,7 +206,7 @@ impl Default for KernelSettings {
             far_point_limit: true,
             zernike_order: 6,
             beta_tolerance: 1e-4,
-            max_beta_degree: 60,
+            max_beta_degree: 120,
             radial_tolerance: 1e-5,
         }
     }
@@ -190,11 +214,17 @@ impl Default for KernelSettings {
 
 impl KernelSettings {
     pub fn validate(&self) -> Result<(), String> {
-        let checks: [(&str, f64, f64, f64); 10] = [
+        let checks: [(&str, f64, f64, f64); 11] = [
             ("sample_um", self.sample_um, 0.05, 100.0),
             ("um_per_deg", self.um_per_deg, 100.0, 500.0),
             ("samples_per_2pi", self.samples_per_2pi, 1.0, 64.0),
             ("samples_per_pixel", self.samples_per_pixel, 1.0, 16.0),
+            (
+                "samples_per_lambda_na",
+                self.samples_per_lambda_na,
+                0.5,
+                64.0,
+            ),
             ("energy", self.energy, 0.5, 0.999999),
             ("diffraction_margin", self.diffraction_margin, 0.0, 100.0),
             ("accommodation_nm", self.accommodation_nm, 380.0, 800.0),

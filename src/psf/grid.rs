@@ -8,10 +8,11 @@
 
 use super::axes::{GridAxes, KernelSettings, Screen};
 use super::defocus::ColumnOptics;
+use super::integrate::BoxIntegrator;
 use super::kernels::{
     kernel_side, level_block_radius, level_count, level_radius_px, KernelGrid, KernelSet,
 };
-use super::project::{cropped_psf, CroppedPsf};
+use super::project::{cropped_psf, PsfMethod, MAX_BINS};
 use crate::eye::Eye;
 use crate::{Error, Result};
 use rayon::prelude::*;
@@ -48,7 +49,16 @@ pub struct ColumnReport {
     pub residual_d: [f64; 3],
     pub beta_degree: [u32; 3],
     pub beta_truncation_error: [f64; 3],
+    /// Worst pupil energy missed by any PSF of the column, per channel: the β truncation of
+    /// the PSFs computed by the ENZ series, 0 for those computed by FFT (which sample the whole
+    /// pupil function).
+    pub missed_energy: [f64; 3],
+    /// PSFs of the column computed by FFT, per channel (the rest by the ENZ series).
+    pub fft_psfs: [usize; 3],
 }
+
+/// Largest pupil energy a kernel's PSF may miss; beyond it the report carries a warning.
+pub const MISSED_ENERGY_LIMIT: f64 = 1e-3;
 
 /// What a grid computation did.
 #[derive(Clone, Debug, Serialize)]
@@ -64,6 +74,13 @@ pub struct GridReport {
     pub min_kept_energy: f64,
     pub largest_psf_side: usize,
     pub bytes_per_set: u64,
+    /// PSFs computed by FFT (the rest by the ENZ series).
+    pub psfs_fft: usize,
+    /// Worst missed pupil energy over every PSF, and the limit it is held to.
+    pub worst_missed_energy: f64,
+    pub missed_energy_limit: f64,
+    /// Kernels whose PSF missed more than the limit (one line per column and channel).
+    pub warnings: Vec<String>,
     pub seconds_optics: f64,
     pub seconds_psfs: f64,
     pub seconds_kernels: f64,
@@ -133,38 +150,43 @@ pub fn kernels_from_columns(
     }
     let no = axes.objects.count;
     let t1 = Instant::now();
-    let jobs: Vec<(usize, usize, usize)> = (0..columns.len())
-        .flat_map(|s| (0..3).flat_map(move |c| (0..no).map(move |o| (s, c, o))))
-        .collect();
+    // PSFs set by set, each kept only as its pixel-integration bins (a set's full-resolution
+    // PSFs would not fit in memory for a whole grid); the largest radius is known at the end.
     let done = AtomicUsize::new(0);
-    let psfs: Vec<CroppedPsf> = jobs
-        .par_iter()
-        .map(|&(s, c, o)| {
-            let p = cropped_psf(
-                &columns[s].channels[c],
-                axes.objects.value_d(o),
-                screen,
-                settings,
-            );
-            progress(
-                Stage::Psfs,
-                done.fetch_add(1, Ordering::Relaxed) + 1,
-                jobs.len(),
-            );
-            p
-        })
-        .collect::<Result<_>>()?;
+    let total = columns.len() * 3 * no;
+    let mut psfs: Vec<PsfSummary> = Vec::with_capacity(total);
+    for col in columns {
+        let jobs: Vec<(usize, usize)> = (0..3).flat_map(|c| (0..no).map(move |o| (c, o))).collect();
+        let part: Vec<PsfSummary> = jobs
+            .par_iter()
+            .map(|&(c, o)| {
+                let p = cropped_psf(&col.channels[c], axes.objects.value_d(o), screen, settings)?;
+                let summary = PsfSummary {
+                    natural_radius_px: p.natural_radius_px(),
+                    natural_half_samples: p.natural_half_samples,
+                    kept_energy: p.kept_energy,
+                    grid_side: p.grid_side,
+                    method: p.method,
+                    missed_energy: p.missed_energy,
+                    bins: p.integrator(settings.max_radius_cap, MAX_BINS),
+                };
+                progress(Stage::Psfs, done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                Ok(summary)
+            })
+            .collect::<Result<_>>()?;
+        psfs.extend(part);
+    }
     let seconds_psfs = t1.elapsed().as_secs_f64();
     let psf = |s: usize, c: usize, o: usize| &psfs[(s * 3 + c) * no + o];
 
     let natural_max = psfs
         .iter()
-        .map(CroppedPsf::natural_radius_px)
+        .map(|p| p.natural_radius_px)
         .fold(0.0f64, f64::max);
     let max_radius = (natural_max.ceil() as u32).min(settings.max_radius_cap);
     let clamped_radii = psfs
         .iter()
-        .filter(|p| p.natural_radius_px() > max_radius as f64)
+        .filter(|p| p.natural_radius_px > max_radius as f64)
         .count();
 
     let t2 = Instant::now();
@@ -175,8 +197,7 @@ pub fn kernels_from_columns(
         let mut set = KernelSet::zeroed(col.pupil_mm, col.focus_d, axes.objects, max_radius);
         for o in 0..no {
             for c in 0..3 {
-                set.radius_px[o][c] =
-                    psf(s, c, o).natural_radius_px().min(max_radius as f64) as f32;
+                set.radius_px[o][c] = psf(s, c, o).natural_radius_px.min(max_radius as f64) as f32;
             }
         }
         // Blocks are laid out level-major: split the texels into one slice per (level, o).
@@ -195,7 +216,9 @@ pub fn kernels_from_columns(
         blocks.par_iter_mut().for_each(|(level, o, block)| {
             let (radius, support) = (level_block_radius(*level), level_radius_px(*level) + 0.5);
             for c in 0..3 {
-                let k = psf(s, c, *o).resample(radius, support);
+                let p = psf(s, c, *o);
+                // the natural half-width spans `support` px: pixels of half_samples / support
+                let k = p.bins.kernel(radius, p.natural_half_samples / support);
                 for (t, v) in block.iter_mut().zip(&k) {
                     t[c] = *v as f32;
                 }
@@ -223,6 +246,31 @@ pub fn kernels_from_columns(
     };
     grid.validate()
         .map_err(|e| Error::input(format!("kernel grid came out invalid: {e}")))?;
+    let column_reports: Vec<ColumnReport> = columns
+        .iter()
+        .enumerate()
+        .map(|(s, c)| {
+            let mut r = column_report(c);
+            for ch in 0..3 {
+                let these = (0..no).map(|o| psf(s, ch, o));
+                r.missed_energy[ch] = these.clone().map(|p| p.missed_energy).fold(0.0, f64::max);
+                r.fft_psfs[ch] = these.filter(|p| p.method == PsfMethod::Fft).count();
+            }
+            r
+        })
+        .collect();
+    let mut warnings = Vec::new();
+    for c in &column_reports {
+        for ch in 0..3 {
+            if c.missed_energy[ch] > MISSED_ENERGY_LIMIT {
+                warnings.push(format!(
+                    "pupil {} mm, focus {} D, {} nm: the PSFs miss {:.2e} of the pupil energy \
+                     (limit {MISSED_ENERGY_LIMIT:e}); their kernels are too small",
+                    c.pupil_mm, c.focus_d, axes.wavelengths_nm[ch], c.missed_energy[ch]
+                ));
+            }
+        }
+    }
     let report = GridReport {
         psfs_computed: psfs.len(),
         psfs_skipped: 0,
@@ -232,12 +280,27 @@ pub fn kernels_from_columns(
         min_kept_energy: psfs.iter().map(|p| p.kept_energy).fold(1.0, f64::min),
         largest_psf_side: psfs.iter().map(|p| p.grid_side).max().unwrap_or(0),
         bytes_per_set: grid.sets.first().map_or(0, KernelSet::size_bytes),
+        psfs_fft: psfs.iter().filter(|p| p.method == PsfMethod::Fft).count(),
+        worst_missed_energy: psfs.iter().map(|p| p.missed_energy).fold(0.0, f64::max),
+        missed_energy_limit: MISSED_ENERGY_LIMIT,
+        warnings,
         seconds_optics: 0.0,
         seconds_psfs,
         seconds_kernels,
-        columns: columns.iter().map(column_report).collect(),
+        columns: column_reports,
     };
     Ok((grid, report))
+}
+
+/// What the kernel stage keeps of one PSF.
+struct PsfSummary {
+    natural_radius_px: f64,
+    natural_half_samples: f64,
+    kept_energy: f64,
+    grid_side: usize,
+    method: PsfMethod,
+    missed_energy: f64,
+    bins: BoxIntegrator,
 }
 
 fn column_report(c: &ColumnOptics) -> ColumnReport {
@@ -256,5 +319,7 @@ fn column_report(c: &ColumnOptics) -> ColumnReport {
             .channels
             .each_ref()
             .map(|ch| ch.pupil.beta.truncation_error),
+        missed_energy: [0.0; 3],
+        fft_psfs: [0; 3],
     }
 }

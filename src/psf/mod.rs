@@ -2,7 +2,8 @@
 //!
 //! - [`axes`]: the grid's axes, the screen and the numerical settings.
 //! - [`defocus`]: one (pupil, focus) state of an eye and the defocus of every object distance.
-//! - [`project`]: PSF sampling, energy crop, area-weighted resampling, screen orientation.
+//! - [`project`]: PSF sampling (ENZ or FFT per PSF), energy crop, screen orientation.
+//! - [`integrate`]: the PSF integrated over screen pixels of any size.
 //! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs.
 //! - [`exact`]: exact kernels at any vergence for the ground truth.
 //! - [`cache`]: grid files and the on-disk cache; [`preview`]: contact sheet and size plot.
@@ -13,6 +14,7 @@ pub mod cache;
 pub mod defocus;
 pub mod exact;
 pub mod grid;
+pub mod integrate;
 pub mod kernels;
 pub mod plan;
 pub mod preview;

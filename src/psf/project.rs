@@ -13,13 +13,33 @@
 //! flare towards −x, so on the screen the flare points left; c(3,−1) > 0 (retinal flare
 //! towards −y) points up on the screen.
 
-use super::axes::{KernelSettings, Screen};
+use super::axes::{KernelSettings, MethodChoice, Screen};
 use super::defocus::ChannelOptics;
+use super::integrate::BoxIntegrator;
+use crate::optics::fft_psf::{fft_cost, psf_by_fft};
 use crate::optics::psf::{pitch_from_arcmin, psf_from_pupil, PsfRequest};
 use crate::Result;
+use serde::Serialize;
 
-/// Largest PSF grid side; beyond it the pitch grows (the kernels are far coarser anyway).
-pub const MAX_PSF_SIDE: usize = 2047;
+/// Largest PSF grid side at the diffraction pitch; beyond it the pitch grows up to
+/// [`KernelSettings::samples_per_pixel`] samples per screen pixel.
+pub const MAX_PSF_SIDE: usize = 1025;
+/// Largest PSF grid side at all (a PSF of several hundred pixels' radius).
+pub const HARD_MAX_PSF_SIDE: usize = 4095;
+
+/// Most bins per side a grid's PSF keeps for pixel integration (memory: a grid holds one set
+/// of bins per PSF until the largest radius is known).
+pub const MAX_BINS: usize = 512;
+
+/// How a PSF was computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PsfMethod {
+    /// The ENZ series of the β expansion (its truncation is the missed pupil energy).
+    Enz,
+    /// The sampled pupil function, transformed ([`crate::optics::fft_psf`]).
+    Fft,
+}
 
 /// A PSF cropped to its energy square, centred on the optical axis (the chief ray).
 #[derive(Clone, Debug, PartialEq)]
@@ -30,13 +50,18 @@ pub struct CroppedPsf {
     /// Natural half-width of the energy square in samples (fractional: the crossing of the
     /// energy fraction interpolated between whole rings), ≤ half + 0.5.
     pub natural_half_samples: f64,
-    /// Sample pitch in screen pixels.
+    /// Sample pitch in screen pixels and in λ/NA.
     pub pixels_per_sample: f64,
+    pub pitch_lambda_na: f64,
     /// Fraction of the grid's energy inside the cropped square.
     pub kept_energy: f64,
     /// Total defocus f used and the grid side the PSF was computed on.
     pub defocus_f: f64,
     pub grid_side: usize,
+    pub method: PsfMethod,
+    /// Pupil energy the computation left out: the β truncation for ENZ, 0 for the sampled
+    /// pupil (which keeps all of it).
+    pub missed_energy: f64,
 }
 
 impl CroppedPsf {
@@ -50,185 +75,48 @@ impl CroppedPsf {
         (self.natural_half_samples * self.pixels_per_sample - 0.5).max(0.0)
     }
 
-    /// Resamples to a kernel of integer `radius` whose half-width r + 0.5 covers the PSF's
-    /// natural half-width scaled to `support_px` (the natural radius plus 0.5 for the grid's
-    /// own kernels; any size for the exact ones). Screen orientation, normalised to sum 1.
-    pub fn resample(&self, radius: u32, support_px: f64) -> Vec<f64> {
-        let side_out = 2 * radius as usize + 1;
-        if radius == 0 || support_px <= 0.0 {
-            let mut v = vec![0.0; side_out * side_out];
-            v[side_out * side_out / 2] = 1.0;
-            return v;
-        }
-        // samples per output pixel
-        let scale = self.natural_half_samples / support_px;
-        let n = self.side();
-        let k = self.half as f64;
-        // Output pixel i covers offsets [i − r − ½, i − r + ½]·scale (samples); sample c covers
-        // [c − k − ½, c − k + ½]. Rows use the same offsets with the sign of y flipped.
-        let weights = |flip: bool| -> Vec<(usize, Vec<f64>)> {
-            (0..side_out)
-                .map(|i| {
-                    let u = i as f64 - radius as f64;
-                    let (a, b) = ((u - 0.5) * scale, (u + 0.5) * scale);
-                    // sample offsets s in [a, b]: index = k + s (columns), k − s (rows)
-                    let lo = (a + k - 0.5).floor().max(0.0) as usize;
-                    let hi = ((b + k + 0.5).ceil() as usize).min(n - 1);
-                    let mut w = Vec::new();
-                    if b + k + 0.5 <= 0.0 || a + k - 0.5 >= (n - 1) as f64 || lo > hi {
-                        return (0, w);
-                    }
-                    for c in lo..=hi {
-                        let s = c as f64 - k;
-                        let ov = (b.min(s + 0.5) - a.max(s - 0.5)).max(0.0);
-                        w.push(ov);
-                    }
-                    if flip {
-                        // rows: sample row q has y = k − q, so offset s ↔ row k − s:
-                        // reverse the run
-                        w.reverse();
-                        let first = n - 1 - hi;
-                        (first, w)
-                    } else {
-                        (lo, w)
-                    }
-                })
-                .collect()
-        };
-        let wx = weights(false);
-        let wy = weights(true);
-        // rows of the PSF reduced along x first
-        let mut tmp = vec![0.0f64; n * side_out];
-        for q in 0..n {
-            let row = &self.values[q * n..(q + 1) * n];
-            let out = &mut tmp[q * side_out..(q + 1) * side_out];
-            for (i, (start, w)) in wx.iter().enumerate() {
-                out[i] = w
-                    .iter()
-                    .zip(&row[*start..])
-                    .map(|(a, b)| a * f64::from(*b))
-                    .sum();
-            }
-        }
-        let mut out = vec![0.0f64; side_out * side_out];
-        for (j, (start, w)) in wy.iter().enumerate() {
-            for (t, wq) in w.iter().enumerate() {
-                if *wq == 0.0 {
-                    continue;
-                }
-                let src = &tmp[(start + t) * side_out..(start + t + 1) * side_out];
-                for (o, s) in out[j * side_out..(j + 1) * side_out].iter_mut().zip(src) {
-                    *o += wq * s;
-                }
-            }
-        }
-        // Binning into whole pixels moves the first moment by up to half a pixel when the PSF
-        // is narrow; a bilinear sub-pixel shift (mass-preserving) puts it back where the
-        // samples inside the window have it.
-        let (_, mx) = axis_moments(&wx, n, side_out, radius, scale, false);
-        let (ty, my) = axis_moments(&wy, n, side_out, radius, scale, true);
-        let (mut m, mut xm, mut ym) = (0.0, 0.0, 0.0);
-        for q in 0..n {
-            if ty[q] == 0.0 && my[q] == 0.0 {
-                continue;
-            }
-            let row = &self.values[q * n..(q + 1) * n];
-            // Σ_c v·tx[c] is the row's total after the x pass
-            let a: f64 = tmp[q * side_out..(q + 1) * side_out].iter().sum();
-            let b: f64 = row.iter().zip(&mx).map(|(v, w)| f64::from(*v) * w).sum();
-            m += ty[q] * a;
-            xm += ty[q] * b;
-            ym += my[q] * a;
-        }
-        if m > 0.0 && m.is_finite() {
-            let (gx, gy) = first_moment(&out, side_out);
-            let total: f64 = out.iter().sum();
-            if total > 0.0 {
-                shift(&mut out, side_out, xm / m - gx / total, false);
-                shift(&mut out, side_out, ym / m - gy / total, true);
-            }
-        }
-        let total: f64 = out.iter().sum();
-        if total > 0.0 && total.is_finite() {
-            out.iter_mut().for_each(|v| *v /= total);
+    /// Prepares pixel integration for kernels up to `max_radius` at their grid scale (the
+    /// natural half-width spanning r + 0.5 px), see [`BoxIntegrator`], keeping at most
+    /// `max_bins` bins per side.
+    pub fn integrator(&self, max_radius: u32, max_bins: usize) -> BoxIntegrator {
+        self.integrator_for_scale(self.scale_for(max_radius as f64 + 0.5), max_bins)
+    }
+
+    /// As [`Self::integrator`] for pixels no smaller than `finest` samples.
+    pub fn integrator_for_scale(&self, finest: f64, max_bins: usize) -> BoxIntegrator {
+        // bins of a quarter λ/NA: the intensity's finest period is half a λ/NA
+        let max_bin = if self.pitch_lambda_na > 0.0 {
+            (0.25 / self.pitch_lambda_na).floor().max(1.0) as usize
         } else {
-            out.iter_mut().for_each(|v| *v = 0.0);
-            out[side_out * side_out / 2] = 1.0;
-        }
-        out
+            1
+        };
+        BoxIntegrator::new(&self.values, self.side(), finest, max_bin, max_bins)
     }
-}
 
-/// Per sample index along one axis: the part of its unit box inside the kernel window, and
-/// that part's first moment in output pixels. `runs` are the resampling weights (see
-/// [`CroppedPsf::resample`]); rows (`flip`) run opposite to the offsets.
-fn axis_moments(
-    runs: &[(usize, Vec<f64>)],
-    n: usize,
-    side_out: usize,
-    radius: u32,
-    scale: f64,
-    flip: bool,
-) -> (Vec<f64>, Vec<f64>) {
-    let mut tot = vec![0.0; n];
-    let mut mom = vec![0.0; n];
-    let k = (n / 2) as f64;
-    for (i, (start, w)) in runs.iter().enumerate().take(side_out) {
-        let u = i as f64 - radius as f64;
-        let (a, b) = ((u - 0.5) * scale, (u + 0.5) * scale);
-        for (t, wt) in w.iter().enumerate() {
-            if *wt <= 0.0 {
-                continue;
-            }
-            let idx = start + t;
-            let s = if flip { k - idx as f64 } else { idx as f64 - k };
-            let (lo, hi) = (a.max(s - 0.5), b.min(s + 0.5));
-            tot[idx] += wt;
-            mom[idx] += wt * 0.5 * (lo + hi) / scale;
-        }
+    /// The kernel of integer `radius` whose half-width r + 0.5 covers the PSF's natural
+    /// half-width scaled to `support_px` (the natural radius plus 0.5 for the grid's own
+    /// kernels; any size for the exact ones): each texel is the PSF integrated over the
+    /// pixel's area. Screen orientation, normalised to sum 1.
+    pub fn resample(&self, radius: u32, support_px: f64) -> Vec<f64> {
+        let scale = self.scale_for(support_px);
+        self.integrator_for_scale(scale, 4 * MAX_BINS)
+            .kernel(radius, scale)
     }
-    (tot, mom)
-}
 
-/// Σ v·dx and Σ v·dy (screen axes, pixels from the centre) of a square kernel.
-fn first_moment(values: &[f64], side: usize) -> (f64, f64) {
-    let c = (side / 2) as f64;
-    let (mut x, mut y) = (0.0, 0.0);
-    for (t, v) in values.iter().enumerate() {
-        x += v * ((t % side) as f64 - c);
-        y += v * ((t / side) as f64 - c);
-    }
-    (x, y)
-}
-
-/// Moves a square kernel's mass by `delta` pixels (|delta| < 1) along x or y (`vertical`),
-/// linearly between neighbours: the first moment moves by exactly `delta`.
-fn shift(values: &mut [f64], side: usize, delta: f64, vertical: bool) {
-    let t = delta.abs().min(1.0);
-    if t == 0.0 || !t.is_finite() {
-        return;
-    }
-    let step: isize = if delta > 0.0 { 1 } else { -1 };
-    let old = values.to_vec();
-    for j in 0..side {
-        for i in 0..side {
-            let (pi, pj) = if vertical {
-                (i as isize, j as isize - step)
-            } else {
-                (i as isize - step, j as isize)
-            };
-            let from = if (0..side as isize).contains(&pi) && (0..side as isize).contains(&pj) {
-                old[pj as usize * side + pi as usize]
-            } else {
-                0.0
-            };
-            values[j * side + i] = (1.0 - t) * old[j * side + i] + t * from;
+    /// Samples per output pixel for a kernel whose natural half-width spans `support_px`.
+    pub fn scale_for(&self, support_px: f64) -> f64 {
+        if support_px > 0.0 {
+            self.natural_half_samples / support_px
+        } else {
+            0.0
         }
     }
 }
 
-/// The sample pitch (λ/NA) for a channel and screen: the finest of the retinal sample size,
-/// N samples per 2π of defocus, and `samples_per_pixel` per output pixel.
+/// The sample pitch (λ/NA) for a channel and screen: fine enough for diffraction (the
+/// intensity is band-limited to 2 cycles per λ/NA; [`KernelSettings::samples_per_lambda_na`]
+/// samples per λ/NA resolve it for the cubic interpolant the pixel integration uses) and for
+/// the screen (`samples_per_pixel` per pixel), and never coarser than the retinal sample.
 pub fn pitch_lambda_na(ch: &ChannelOptics, screen: &Screen, settings: &KernelSettings) -> f64 {
     let retinal = pitch_from_arcmin(
         60.0 * settings.sample_um / settings.um_per_deg,
@@ -236,8 +124,22 @@ pub fn pitch_lambda_na(ch: &ChannelOptics, screen: &Screen, settings: &KernelSet
         ch.wavelength_nm,
     );
     let per_2pi = 4.0 / settings.samples_per_2pi;
-    let pixel = 1.0 / (screen.px_per_radian() * ch.radians_per_lambda_na());
-    retinal.min(per_2pi).min(pixel / settings.samples_per_pixel)
+    let pixel = pixel_lambda_na(ch, screen);
+    // the diffraction pitch, but never more than MAX_SAMPLES_PER_PIXEL per pixel: a pixel
+    // that wide averages the intensity's finest ripples out, except at its edges
+    let diffraction = (1.0 / settings.samples_per_lambda_na).max(pixel / MAX_SAMPLES_PER_PIXEL);
+    retinal
+        .min(per_2pi)
+        .min(diffraction)
+        .min(pixel / settings.samples_per_pixel)
+}
+
+/// Samples per screen pixel beyond which the diffraction pitch is relaxed.
+pub const MAX_SAMPLES_PER_PIXEL: f64 = 64.0;
+
+/// One screen pixel at the centre of the frame in λ/NA.
+pub fn pixel_lambda_na(ch: &ChannelOptics, screen: &Screen) -> f64 {
+    1.0 / (screen.px_per_radian() * ch.radians_per_lambda_na())
 }
 
 /// Computes the PSF of `ch` for an object at `object_d` dioptres and crops it.
@@ -251,40 +153,88 @@ pub fn cropped_psf(
     cropped_psf_at_f(ch, f, screen, settings)
 }
 
-/// As [`cropped_psf`] for a given total defocus f.
+/// The grid a PSF at defocus f is computed on: (pitch in λ/NA, half side in samples). The grid
+/// covers the geometric (ray) extent plus the diffraction margin; beyond [`MAX_PSF_SIDE`] the
+/// pitch grows, but never past `samples_per_pixel / 2` samples per pixel.
+pub fn psf_grid(
+    ch: &ChannelOptics,
+    f: f64,
+    screen: &Screen,
+    settings: &KernelSettings,
+) -> (f64, usize) {
+    let mut pitch = pitch_lambda_na(ch, screen, settings);
+    let half_extent = ch.ray_extent(f) * 1.02 + settings.diffraction_margin + pitch;
+    let mut half = (half_extent / pitch).ceil() as usize;
+    if 2 * half + 1 > MAX_PSF_SIDE {
+        let coarsest = 2.0 * pixel_lambda_na(ch, screen) / settings.samples_per_pixel;
+        pitch = (half_extent / (MAX_PSF_SIDE / 2) as f64).min(coarsest.max(pitch));
+        half = ((half_extent / pitch).ceil() as usize).min(HARD_MAX_PSF_SIDE / 2);
+        pitch = pitch.max(half_extent / half as f64);
+    }
+    (pitch, half)
+}
+
+/// Estimated cost of the ENZ synthesis of a `size`² grid (the units of
+/// [`crate::optics::fft_psf::fft_cost`]): every pixel sums one radial value per azimuthal
+/// order, four mirror pixels at a time, and every distinct radius costs a Bessel sequence
+/// and one short series per order.
+pub fn enz_cost(degree: u32, size: usize) -> f64 {
+    let combos = 2.0 * degree as f64 + 1.0;
+    let terms = ((degree + 1) * (degree + 2) / 2) as f64;
+    let pixels = (size * size) as f64;
+    ENZ_PIXEL_UNITS * pixels * combos + ENZ_RADIUS_UNITS * (pixels / 8.0 + 64.0) * (terms + 40.0)
+}
+
+/// Calibration of [`enz_cost`] against [`fft_cost`] (measured with `cargo bench --bench
+/// kernels -- --methods` on x86-64).
+const ENZ_PIXEL_UNITS: f64 = 5.0;
+const ENZ_RADIUS_UNITS: f64 = 2.0;
+
+/// As [`cropped_psf`] for a given total defocus f. The method is chosen per PSF: the ENZ
+/// series where the channel's β expansion met its tolerance and is the cheaper of the two,
+/// else the transform of the sampled pupil.
 pub fn cropped_psf_at_f(
     ch: &ChannelOptics,
     f: f64,
     screen: &Screen,
     settings: &KernelSettings,
 ) -> Result<CroppedPsf> {
-    let mut pitch = pitch_lambda_na(ch, screen, settings);
-    let half_extent = ch.ray_extent(f) * 1.02 + settings.diffraction_margin + pitch;
-    let mut half = (half_extent / pitch).ceil() as usize;
-    if 2 * half + 1 > MAX_PSF_SIDE {
-        half = MAX_PSF_SIDE / 2;
-        pitch = half_extent / half as f64;
-    }
-    let mut req = PsfRequest::new(
-        Vec::new(),
-        ch.pupil_mm,
-        ch.wavelength_nm,
-        pitch,
-        2 * half + 1,
-    );
-    req.include_tilt = false;
-    req.radial_tolerance = settings.radial_tolerance;
-    req.beta_tolerance = settings.beta_tolerance;
-    req.defocus_f = f;
-    let psf = psf_from_pupil(&ch.pupil, &req)?;
+    let (pitch, half) = psf_grid(ch, f, screen, settings);
+    let size = 2 * half + 1;
+    let beta = &ch.pupil.beta;
+    let converged = beta.truncation_error <= settings.beta_tolerance;
+    let method = match settings.method {
+        MethodChoice::Enz => PsfMethod::Enz,
+        MethodChoice::Fft => PsfMethod::Fft,
+        MethodChoice::Auto => {
+            if converged && enz_cost(beta.degree, size) <= fft_cost(pitch, size) {
+                PsfMethod::Enz
+            } else {
+                PsfMethod::Fft
+            }
+        }
+    };
+    let (intensity, missed) = match method {
+        PsfMethod::Enz => {
+            let mut req = PsfRequest::new(Vec::new(), ch.pupil_mm, ch.wavelength_nm, pitch, size);
+            req.include_tilt = false;
+            req.radial_tolerance = settings.radial_tolerance;
+            req.beta_tolerance = settings.beta_tolerance;
+            req.defocus_f = f;
+            let psf = psf_from_pupil(&ch.pupil, &req)?;
+            (psf.intensity, beta.truncation_error)
+        }
+        PsfMethod::Fft => (
+            psf_by_fft(&ch.alpha_um, ch.wavelength_nm, f, pitch, size)?,
+            0.0,
+        ),
+    };
     let pixels_per_sample = pitch * ch.radians_per_lambda_na() * screen.px_per_radian();
-    Ok(crop(
-        &psf.intensity,
-        2 * half + 1,
-        settings.energy,
-        pixels_per_sample,
-        f,
-    ))
+    let mut p = crop(&intensity, size, settings.energy, pixels_per_sample, f);
+    p.pitch_lambda_na = pitch;
+    p.method = method;
+    p.missed_energy = missed;
+    Ok(p)
 }
 
 /// Smallest centred square keeping `fraction` of the energy of a `side`² grid (odd side,
@@ -340,8 +290,11 @@ pub fn crop(
         values,
         natural_half_samples: natural.clamp(0.0, k as f64 + 0.5),
         pixels_per_sample,
+        pitch_lambda_na: 0.0,
         kept_energy: if total > 0.0 { kept / total } else { 1.0 },
         defocus_f,
         grid_side: side,
+        method: PsfMethod::Enz,
+        missed_energy: 0.0,
     }
 }

@@ -147,6 +147,10 @@ pub fn prepare_kernels(
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    // a kernel whose PSF misses pupil energy beyond the limit is never silent
+    for w in report.iter().flat_map(|r| &r.warnings) {
+        eprintln!("warning: {w}");
+    }
     match &outcome {
         CacheOutcome::Stored {
             warning: Some(w), ..
