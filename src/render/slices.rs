@@ -60,55 +60,67 @@ pub fn render(input: &FrameInput<'_>, kernels: &dyn ExactKernels, slices: usize)
 type Planes = (Vec<[f32; 3]>, Vec<[f32; 3]>);
 
 /// Scatters every pixel of slice `s` through its channel's kernel: (colour·coverage, coverage).
+/// Bands of source rows scatter in parallel into their own buffers, which are then added in
+/// band order: identical inputs give identical bits (a shared parallel reduction would add
+/// the same terms in an order that depends on scheduling).
 fn blur_slice(
     input: &FrameInput<'_>,
     members: &[usize],
     s: usize,
     kernels: &[Kernel; 3],
 ) -> Planes {
+    const BAND_ROWS: usize = 16;
     let (w, h) = (input.width as usize, input.height as usize);
-    let empty = || (vec![[0.0f32; 3]; w * h], vec![[0.0f32; 3]; w * h]);
-    (0..h)
+    let reach = kernels.iter().map(|k| k.radius as usize).max().unwrap_or(0);
+    // Per band: the first output row it touches and its (colour, coverage) rows from there.
+    let bands: Vec<(usize, Planes)> = (0..h.div_ceil(BAND_ROWS))
         .into_par_iter()
-        .fold(empty, |(mut col, mut alp), y| {
-            for x in 0..w {
-                let i = y * w + x;
-                if members[i] != s {
-                    continue;
-                }
-                for (c, k) in kernels.iter().enumerate() {
-                    let r = k.radius as i64;
-                    for dy in -r..=r {
-                        let ty = y as i64 + dy;
-                        if ty < 0 || ty >= h as i64 {
-                            continue;
-                        }
-                        for dx in -r..=r {
-                            let tx = x as i64 + dx;
-                            if tx < 0 || tx >= w as i64 {
+        .map(|band| {
+            let (y0, y1) = (band * BAND_ROWS, ((band + 1) * BAND_ROWS).min(h));
+            let top = y0.saturating_sub(reach);
+            let rows = (y1 + reach).min(h) - top;
+            let mut col = vec![[0.0f32; 3]; rows * w];
+            let mut alp = vec![[0.0f32; 3]; rows * w];
+            for y in y0..y1 {
+                for x in 0..w {
+                    let i = y * w + x;
+                    if members[i] != s {
+                        continue;
+                    }
+                    for (c, k) in kernels.iter().enumerate() {
+                        let r = k.radius as i64;
+                        for dy in -r..=r {
+                            let ty = y as i64 + dy;
+                            if ty < 0 || ty >= h as i64 {
                                 continue;
                             }
-                            let weight = k.at(dx, dy);
-                            let t = ty as usize * w + tx as usize;
-                            col[t][c] += weight * input.color[i][c];
-                            alp[t][c] += weight;
+                            for dx in -r..=r {
+                                let tx = x as i64 + dx;
+                                if tx < 0 || tx >= w as i64 {
+                                    continue;
+                                }
+                                let weight = k.at(dx, dy);
+                                let t = (ty as usize - top) * w + tx as usize;
+                                col[t][c] += weight * input.color[i][c];
+                                alp[t][c] += weight;
+                            }
                         }
                     }
                 }
             }
-            (col, alp)
+            (top, (col, alp))
         })
-        .reduce(empty, |(mut c1, mut a1), (c2, a2)| {
-            for (x, y) in c1.iter_mut().zip(&c2) {
-                for c in 0..3 {
-                    x[c] += y[c];
-                }
+        .collect();
+    let mut col = vec![[0.0f32; 3]; w * h];
+    let mut alp = vec![[0.0f32; 3]; w * h];
+    for (top, (bc, ba)) in bands {
+        let start = top * w;
+        for (t, (c, a)) in bc.iter().zip(&ba).enumerate() {
+            for k in 0..3 {
+                col[start + t][k] += c[k];
+                alp[start + t][k] += a[k];
             }
-            for (x, y) in a1.iter_mut().zip(&a2) {
-                for c in 0..3 {
-                    x[c] += y[c];
-                }
-            }
-            (c1, a1)
-        })
+        }
+    }
+    (col, alp)
 }
