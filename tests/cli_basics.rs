@@ -70,3 +70,17 @@ fn nonexistent_device_fails_with_exit_code_2_and_one_line() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// `--age` outside the pupil formula's range (or not a number) is refused at the boundary.
+#[test]
+fn age_outside_the_pupil_formula_is_refused() {
+    for bad in ["-5", "0", "300", "inf", "nan", "abc"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_ocular"))
+            .args(["render", "--age", bad, "-o", "/nonexistent/x.png"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--age {bad}: {err}");
+        assert!(err.contains("--age"), "--age {bad}: {err}");
+    }
+}

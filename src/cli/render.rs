@@ -113,8 +113,8 @@ pub struct RenderArgs {
     /// Pupil formula for luminance-driven pupils.
     #[arg(long, value_enum, default_value = "watson-yellott")]
     pub pupil_model: PupilModel,
-    /// Observer age (years) for the Watson–Yellott formula.
-    #[arg(long, default_value_t = 30.0)]
+    /// Observer age (years) for the Watson–Yellott formula, which covers ages 20 to 83.
+    #[arg(long, default_value_t = 30.0, value_parser = parse_age_years, allow_hyphen_values = true)]
     pub age: f64,
     /// Vertical field of view in degrees; required with --color (scenes use their camera's).
     #[arg(
@@ -321,6 +321,20 @@ pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
         Err(Error::Input(message)) => Err(Error::Input(format!("--eye: {message}"))),
         Err(other) => Err(other),
     }
+}
+
+/// `--age`: a number of years within the range Watson & Yellott fitted (20 to 83).
+fn parse_age_years(text: &str) -> std::result::Result<f64, String> {
+    let age: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("{text:?} is not a number of years"))?;
+    if !(age.is_finite() && (20.0..=83.0).contains(&age)) {
+        return Err(format!(
+            "{age} years is outside 20 to 83, the ages the Watson–Yellott pupil formula covers"
+        ));
+    }
+    Ok(age)
 }
 
 /// The focus vergence asked for (D) and the words naming where it came from, for messages.
