@@ -12,7 +12,7 @@ use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
-use crate::render::frame::{dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method};
+use crate::render::frame::{FrameRenderer, Method};
 use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -242,20 +242,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
     let (focus_d, pupil_mm) = (eye_state.focus_d, eye_state.pupil_mm);
     let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
-    let kernels = prepare_kernels(
-        &eye,
-        &scene_needs(
-            &[dioptre_range(
-                &frame.depth_m,
-                width,
-                height,
-                screen.fov_y_deg,
-            )],
-            &[eye_state],
-            screen,
-        ),
-        &options,
-    )?;
+    let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let precompute = Precompute {
         from_cache: kernels.report.is_none(),
         psfs: kernels.report.as_ref().map_or(0, |r| r.psfs_computed),

@@ -13,9 +13,7 @@ use super::Cli;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
 use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
-use crate::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method, RenderedFrame,
-};
+use crate::render::frame::{FrameRenderer, Method, RenderedFrame};
 use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -197,20 +195,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 .replace("sample_um", "--sample-um"),
         )
     })?;
-    let kernels = prepare_kernels(
-        &eye,
-        &scene_needs(
-            &[dioptre_range(
-                &frame.depth_m,
-                width,
-                height,
-                screen.fov_y_deg,
-            )],
-            &[eye_state],
-            screen,
-        ),
-        &options,
-    )?;
+    let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     renderer.slice_count = args.slices;
     let input = FrameInput {

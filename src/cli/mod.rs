@@ -206,6 +206,25 @@ pub(crate) fn measured_scene_frame(
     ))
 }
 
+/// The kernels one measured frame (from [`measured_scene_frame`]) needs: its depth range
+/// along the rays, its eye state and screen.
+pub(crate) fn frame_kernels(
+    eye: &crate::eye::Eye,
+    frame: &crate::render::Frame,
+    state: crate::render::frame::EyeState,
+    screen: crate::psf::axes::Screen,
+    options: &crate::render::frame::KernelOptions,
+) -> Result<crate::render::frame::PreparedKernels> {
+    let range = crate::render::frame::dioptre_range(
+        &frame.depth_m,
+        frame.width,
+        frame.height,
+        screen.fov_y_deg,
+    );
+    let needs = crate::render::frame::scene_needs(&[range], &[state], screen);
+    crate::render::frame::prepare_kernels(eye, &needs, options)
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a
 /// reader never sees a partial file and a failed run leaves no file behind.
 pub(crate) fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {

@@ -332,22 +332,23 @@ impl KernelGrid {
 
     /// Natural radii blended like the kernels (what the fragment pass reads each frame).
     pub fn blended_radii(&self, blend: &GridBlend) -> Vec<[f32; 3]> {
-        let mut out = vec![[0.0f32; 3]; self.objects.count];
-        for &(index, w) in &blend.corners {
-            for (o, r) in self.sets[index].radius_px.iter().enumerate() {
-                for c in 0..3 {
-                    out[o][c] += (w as f32) * r[c];
-                }
-            }
-        }
-        out
+        self.blend_objects(blend, |set| &self.sets[set].radius_px)
     }
 
     /// Per-set values (one triple per object distance) blended like the kernels.
     pub fn blend_per_object(&self, blend: &GridBlend, per_set: &[Vec<[f32; 3]>]) -> Vec<[f32; 3]> {
+        self.blend_objects(blend, |set| &per_set[set])
+    }
+
+    /// Σ over the blend's corners of weight × the corner set's per-object triples.
+    fn blend_objects<'a>(
+        &self,
+        blend: &GridBlend,
+        values: impl Fn(usize) -> &'a [[f32; 3]],
+    ) -> Vec<[f32; 3]> {
         let mut out = vec![[0.0f32; 3]; self.objects.count];
         for &(index, w) in &blend.corners {
-            for (o, r) in per_set[index].iter().enumerate() {
+            for (o, r) in values(index).iter().enumerate() {
                 for c in 0..3 {
                     out[o][c] += (w as f32) * r[c];
                 }

@@ -104,20 +104,18 @@ pub fn render_with(
 
     // Reach of each pixel's fragment in screen pixels: the largest kernel radius over its
     // channels, stretched by the local scale (bilinear lookups reach one texel further).
-    let reach: Vec<i64> = bins
+    // The largest kernel radius over each fragment's channels sets how much of the local scale
+    // applies, and with it the fragment's reach in screen pixels.
+    let natural: Vec<u32> = bins
+        .iter()
+        .map(|&b| (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0))
+        .collect();
+    let reach: Vec<i64> = natural
         .iter()
         .zip(&scales)
-        .map(|(&b, s)| {
-            let r = (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0);
-            i64::from(s.reach_px(r, f64::from(r)))
-        })
+        .map(|(&r, s)| i64::from(s.reach_px(r, f64::from(r))))
         .collect();
     let max_reach = reach.iter().copied().max().unwrap_or(0);
-    // The largest kernel radius over the channels sets how much of the local scale applies.
-    let natural: Vec<f64> = bins
-        .iter()
-        .map(|&b| (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0) as f64)
-        .collect();
     const TILE: usize = 16;
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
@@ -166,7 +164,7 @@ pub fn render_with(
                         }
                         let s = &scales[i];
                         let d = [(px - fx) as f64, (py - fy) as f64];
-                        let r = natural[i];
+                        let r = f64::from(natural[i]);
                         for (ch, p) in pixel.iter_mut().enumerate() {
                             let k = lookup(ch, bins[i]);
                             let weight = if s.for_radius(r)[0] < 1.0 {
