@@ -115,7 +115,12 @@ pub struct BlendArgs {
     #[arg(long, value_enum, default_value = "grouped")]
     pub blend: crate::render::blend::BlendMode,
     /// Largest vergence step (D) between consecutive fragments of one depth group.
-    #[arg(long, value_name = "D", default_value_t = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D)]
+    #[arg(
+        long,
+        value_name = "D",
+        default_value_t = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D,
+        allow_hyphen_values = true
+    )]
     pub group_tolerance_d: f32,
     /// Use the seed paper's narrow-field geometry: vergence from view-axis depth and every
     /// kernel at the image centre's scale (default: vergence along each pixel's ray and
