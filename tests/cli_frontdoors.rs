@@ -384,3 +384,30 @@ fn compare_reports_quality_and_writes_maps() {
         assert_eq!(png_size(&dir.join("maps").join(f)), (128, 72), "{f}");
     }
 }
+
+/// `render --scene FILE` without `--size` renders at the scene's `[camera] resolution`, as
+/// scenes/README.md promises (it used to render 640×360 whatever the file said).
+#[test]
+fn render_uses_the_scene_resolution() {
+    let dir = temp_dir("scene-resolution");
+    let scene = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/primitives.toml"),
+    )
+    .unwrap()
+    .replace("resolution = [1280, 720]", "resolution = [72, 40]");
+    assert!(scene.contains("[72, 40]"));
+    let scene_path = dir.join("tiny.toml");
+    std::fs::write(&scene_path, scene).unwrap();
+    let out = dir.join("frame.png");
+    run_ok(
+        ocular()
+            .arg("render")
+            .arg("--scene")
+            .arg(&scene_path)
+            .args(["--eye", "navarro", "--cache"])
+            .arg(cache())
+            .arg("-o")
+            .arg(&out),
+    );
+    assert_eq!(png_size(&out), (72, 40));
+}

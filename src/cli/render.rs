@@ -124,7 +124,8 @@ pub struct RenderArgs {
         requires = "color"
     )]
     pub fov_y: Option<f64>,
-    /// Frame size for scenes (default 640x360); files keep their own size.
+    /// Frame size for scenes (default: the scene's `[camera] resolution`, 1280x720 for the
+    /// shipped scenes); colour/depth files keep their own size.
     #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with = "color")]
     pub size: Option<(u32, u32)>,
     /// Scene time in seconds (keyframes).
@@ -279,7 +280,9 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
         )));
     }
     let state = scene.at_time(args.time);
-    let (width, height) = args.size.unwrap_or((640, 360));
+    let (width, height) = args
+        .size
+        .unwrap_or((scene.resolution[0], scene.resolution[1]));
     let mut rasterizer = Rasterizer::new(ctx)?;
     let frame = rasterizer.render(ctx, &state, width, height)?;
     let mut depth_m = frame.depth_m;
