@@ -105,18 +105,16 @@ fn line_of(text: &str, byte: usize) -> usize {
 }
 
 fn check_pupil_wavelength(file: &str, pupil: f64, wl: f64) -> Result<(), AberrationError> {
-    if !(pupil.is_finite() && pupil > 0.0 && pupil <= 20.0) {
-        return Err(AberrationError::Invalid {
-            file: file.into(),
-            message: format!("pupil diameter {pupil} mm is not allowed; need 0 < pupil <= 20 mm"),
-        });
-    }
-    if !(wl.is_finite() && (350.0..=1100.0).contains(&wl)) {
-        return Err(AberrationError::Invalid {
-            file: file.into(),
-            message: format!("wavelength {wl} nm is not allowed; need 350 to 1100 nm"),
-        });
-    }
+    let invalid = |message| AberrationError::Invalid {
+        file: file.into(),
+        message,
+    };
+    crate::limits::PUPIL_MM
+        .check("pupil diameter", pupil)
+        .map_err(invalid)?;
+    crate::limits::WAVELENGTH_NM
+        .check("wavelength", wl)
+        .map_err(invalid)?;
     Ok(())
 }
 

@@ -11,6 +11,7 @@ pub mod eye;
 pub mod gpu;
 pub mod image_io;
 pub mod inputs;
+pub mod limits;
 pub mod metrics;
 pub mod optics;
 pub mod psf;

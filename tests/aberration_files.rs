@@ -53,14 +53,14 @@ fn toml_round_trip_and_errors() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("pupil diameter") && e.contains("0 < pupil"),
+        e.contains("pupil diameter") && e.contains("1 to 9 mm"),
         "{e}"
     );
     let bad = "pupil_diameter_mm = 5.0\nwavelength_nm = 1550\n";
     assert!(ZernikeSet::from_toml_str(bad, "e")
         .unwrap_err()
         .to_string()
-        .contains("350 to 1100"));
+        .contains("380 to 1000 nm"));
     let bad = "pupil_diameter_mm = 5.0\nwavelength_nm = 550\n[[term]]\nn = 2\nm = 0\num = nan\n";
     assert!(ZernikeSet::from_toml_str(bad, "e")
         .unwrap_err()

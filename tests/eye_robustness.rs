@@ -319,3 +319,44 @@ fn every_corneal_elevation_term_at_its_bound() {
     let r = measure(&eye.system().unwrap(), 555.0, 4.0, None, 6).unwrap();
     assert!(finite(&r));
 }
+
+/// A very distant object is infinity to within rounding: the wavefront of a point 10¹⁰ m away
+/// is the plane wave's (it used to lose micrometres to paths of 10¹³ mm, and accommodation for
+/// a focus of 10⁻⁸ D failed to converge). At 100 m the defocus term moves by the object's
+/// vergence, −0.01 D, as the paraxial relation c(2,0) = −M·r²/(4√3) says.
+#[test]
+fn distant_objects_join_infinity_smoothly() {
+    let sys = Eye::navarro().system().unwrap();
+    let (wl, pupil) = (555.0, 6.0);
+    let inf = measure(&sys, wl, pupil, None, 6).unwrap();
+    for d_m in [1e4, 1e8, 1e10, 1e13] {
+        let far = measure(&sys, wl, pupil, Some(d_m), 6).unwrap();
+        for (a, b) in inf.coefficient_list().iter().zip(far.coefficient_list()) {
+            // The vergence 1/d adds a ρ² wave: c(2,0) moves by −r²/(4√3)/d µm (a +1/d D
+            // refraction) and piston by √3 times that.
+            let dc20 = -9.0 / (4.0 * 3f64.sqrt()) / d_m;
+            let expected = match (a.n, a.m) {
+                (2, 0) => dc20,
+                (0, 0) => 3f64.sqrt() * dc20,
+                _ => 0.0,
+            };
+            assert!(
+                (b.um - a.um - expected).abs() < 1e-7,
+                "Z({},{}) at {d_m} m: {} vs infinity {}",
+                a.n,
+                a.m,
+                b.um,
+                a.um
+            );
+        }
+    }
+    let near = measure(&sys, wl, pupil, Some(100.0), 6).unwrap();
+    let dc20 = near.coefficient_um(2, 0) - inf.coefficient_um(2, 0);
+    let vergence = -9.0 / (4.0 * 3f64.sqrt()) / 100.0;
+    assert!(
+        (dc20 - vergence).abs() < 0.05 * vergence.abs(),
+        "c(2,0) moved {dc20} µm for an object at 100 m; vergence predicts {vergence}"
+    );
+    let accommodated = accommodate(&Eye::navarro(), Some(1e8), 4.0, 555.0);
+    assert!(accommodated.is_ok(), "{accommodated:?}");
+}

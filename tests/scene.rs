@@ -214,7 +214,7 @@ fn malformed_scene_files_name_file_line_and_what_is_allowed() {
     let text = "[camera]\nposition = [0.0, 0.0, 0.0]\nfov_y_deg = 200.0\n";
     let (_, message) = file_error(Scene::from_toml(text, "x.toml", Path::new(".")));
     assert!(
-        message.contains("fov_y_deg") && message.contains("179"),
+        message.contains("fov_y_deg") && message.contains("0.1 to 170 degrees"),
         "{message}"
     );
 }

@@ -160,13 +160,10 @@ fn finite_option(name: &str, v: Option<f64>) -> Result<()> {
 }
 
 fn check_pupil(p: f64) -> Result<()> {
-    if p.is_finite() && (1.0..=9.0).contains(&p) {
-        Ok(())
-    } else {
-        Err(Error::input(format!(
-            "--pupil-mm {p} is not allowed; need 1 to 9 mm"
-        )))
-    }
+    crate::limits::PUPIL_MM
+        .check("--pupil-mm", p)
+        .map(|_| ())
+        .map_err(Error::input)
 }
 
 /// The target wavefront from the options, and a one-line description of its source.

@@ -195,11 +195,9 @@ pub(crate) fn measured_scene_frame(
         0.0
     };
     let pupil_mm = pupil_mm.or(state.pupil_mm).unwrap_or(5.0);
-    if !(1.0..=9.0).contains(&pupil_mm) {
-        return Err(crate::Error::input(format!(
-            "--pupil-mm {pupil_mm} is outside 1–9 mm"
-        )));
-    }
+    crate::limits::PUPIL_MM
+        .check("--pupil-mm", pupil_mm)
+        .map_err(crate::Error::input)?;
     let screen = crate::psf::axes::Screen {
         fov_y_deg: state.camera.fov_y_deg,
         height_px: height,

@@ -40,7 +40,7 @@ pub struct PsfArgs {
     /// rescaled exactly to a smaller concentric pupil). Default: the set's pupil.
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub pupil_mm: Option<f64>,
-    /// Wavelength (nm, 350–1100). The wavefront in µm is taken as given at this wavelength
+    /// Wavelength (nm, 380–1000). The wavefront in µm is taken as given at this wavelength
     /// (no chromatic aberration: use an eye model for that). Default: the set's wavelength.
     #[arg(long, value_name = "NM", allow_negative_numbers = true)]
     pub wavelength_nm: Option<f64>,
@@ -159,11 +159,9 @@ pub fn run(args: &PsfArgs) -> Result<()> {
         set
     };
     let wavelength_nm = args.wavelength_nm.unwrap_or(set.wavelength_nm);
-    if !(350.0..=1100.0).contains(&wavelength_nm) {
-        return Err(Error::input(format!(
-            "--wavelength-nm {wavelength_nm} is outside 350–1100 nm"
-        )));
-    }
+    crate::limits::WAVELENGTH_NM
+        .check("--wavelength-nm", wavelength_nm)
+        .map_err(Error::input)?;
     if !args.defocus_d.is_finite() {
         return Err(Error::input(
             "--defocus-d must be a finite number of dioptres",

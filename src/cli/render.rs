@@ -193,13 +193,10 @@ fn check_file_options(args: &RenderArgs) -> Result<()> {
 }
 
 fn check_fov(fov_y_deg: f64) -> Result<()> {
-    if fov_y_deg.is_finite() && fov_y_deg > 0.0 && fov_y_deg < 180.0 {
-        Ok(())
-    } else {
-        Err(Error::input(format!(
-            "--fov-y {fov_y_deg} must be a vertical field of view in (0, 180) degrees"
-        )))
-    }
+    crate::limits::FOV_Y_DEG
+        .check("--fov-y", fov_y_deg)
+        .map(|_| ())
+        .map_err(Error::input)
 }
 
 fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
@@ -416,9 +413,9 @@ fn mean_luminance(color: &[[f32; 4]]) -> f64 {
 
 fn pupil_diameter(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
     if let Some(p) = args.pupil_mm {
-        if !(p.is_finite() && (1.0..=9.0).contains(&p)) {
-            return Err(Error::input(format!("--pupil-mm {p} is outside 1–9 mm")));
-        }
+        crate::limits::PUPIL_MM
+            .check("--pupil-mm", p)
+            .map_err(Error::input)?;
         return Ok((p, "given".into()));
     }
     let (luminance, source) = if let Some(l) = args.luminance_cdm2 {

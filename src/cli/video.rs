@@ -322,9 +322,9 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         )));
     }
     if let Some(p) = args.pupil_mm {
-        if !(1.0..=9.0).contains(&p) {
-            return Err(Error::input(format!("--pupil-mm {p} is outside 1–9 mm")));
-        }
+        crate::limits::PUPIL_MM
+            .check("--pupil-mm", p)
+            .map_err(Error::input)?;
     }
     if let Some(ev) = args.exposure {
         if !ev.is_finite() {

@@ -318,16 +318,12 @@ fn check_inputs(
     pupil_mm: f64,
     object_distance_m: Option<f64>,
 ) -> Result<(), EyeError> {
-    if !(wavelength_nm.is_finite() && (300.0..=1100.0).contains(&wavelength_nm)) {
-        return Err(EyeError::Invalid(format!(
-            "wavelength {wavelength_nm} nm is outside 300–1100 nm"
-        )));
-    }
-    if !(pupil_mm.is_finite() && pupil_mm > 0.0 && pupil_mm <= 10.0) {
-        return Err(EyeError::Invalid(format!(
-            "pupil diameter {pupil_mm} mm is outside (0, 10] mm"
-        )));
-    }
+    crate::limits::WAVELENGTH_NM
+        .check("wavelength", wavelength_nm)
+        .map_err(EyeError::Invalid)?;
+    crate::limits::PUPIL_MM
+        .check("pupil diameter", pupil_mm)
+        .map_err(EyeError::Invalid)?;
     if let Some(d) = object_distance_m {
         if !(d.is_finite() && d > 0.02) {
             return Err(EyeError::Invalid(format!(
@@ -341,15 +337,32 @@ fn check_inputs(
 /// Ray factory for normalised pupil coordinates (u, v) on the entrance pupil.
 fn launcher(object_distance_m: Option<f64>, radius_mm: f64, ep_z: f64) -> impl Fn(f64, f64) -> Ray {
     move |u: f64, v: f64| match object_distance_m {
-        Some(d) => Ray::towards(
-            [0.0, 0.0, -1000.0 * d],
-            [radius_mm * u, radius_mm * v, ep_z],
-        ),
+        Some(d) => spherical_wave_ray(1000.0 * d, [radius_mm * u, radius_mm * v], ep_z),
         None => Ray {
             p: [radius_mm * u, radius_mm * v, -5.0],
             d: [0.0, 0.0, 1.0],
             opl_mm: 0.0,
         },
+    }
+}
+
+/// The ray from an on-axis point `object_mm` before the corneal vertex, aimed at `aim` on the
+/// entrance-pupil plane `ep_z`, started where it crosses the object's spherical wavefront
+/// through (0, 0, −5 mm), with optical path zero there (every start point is equally far from
+/// the object). Starting at the object itself would carry paths of ~10¹³ mm for a focus of
+/// 10⁻¹⁰ D, whose differences lose micrometres to rounding; the sag is written so that no
+/// large numbers cancel.
+fn spherical_wave_ray(object_mm: f64, aim: [f64; 2], ep_z: f64) -> Ray {
+    const START_Z: f64 = -5.0;
+    let axial = ep_z + object_mm;
+    let h2 = aim[0] * aim[0] + aim[1] * aim[1];
+    let s = (h2 + axial * axial).sqrt();
+    let radius = object_mm + START_Z;
+    let sag = radius * h2 / (s * (s + axial));
+    Ray {
+        p: [radius * aim[0] / s, radius * aim[1] / s, START_Z - sag],
+        d: [aim[0] / s, aim[1] / s, axial / s],
+        opl_mm: 0.0,
     }
 }
 

@@ -65,11 +65,16 @@ impl GridAxes {
             ));
         }
         check_axis("focus-d", &self.focus_d, 0.0, 50.0, "0 to 50 D")?;
-        check_axis("pupils-mm", &self.pupils_mm, 0.5, 10.0, "0.5 to 10 mm")?;
+        let pupils = crate::limits::PUPIL_MM;
+        check_axis(
+            "pupils-mm",
+            &self.pupils_mm,
+            pupils.min,
+            pupils.max,
+            &pupils.allowed(),
+        )?;
         for w in self.wavelengths_nm {
-            if !(w.is_finite() && (380.0..=800.0).contains(&w)) {
-                return Err(format!("wavelengths-nm: {w} nm is outside 380 to 800 nm"));
-            }
+            crate::limits::WAVELENGTH_NM.check("wavelengths-nm:", w)?;
         }
         Ok(())
     }
@@ -116,12 +121,7 @@ impl Screen {
     }
 
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.fov_y_deg.is_finite() && self.fov_y_deg > 0.1 && self.fov_y_deg < 170.0) {
-            return Err(format!(
-                "fov-y: {} degrees is outside 0.1 to 170",
-                self.fov_y_deg
-            ));
-        }
+        crate::limits::FOV_Y_DEG.check("fov-y:", self.fov_y_deg)?;
         if !(16..=16384).contains(&self.height_px) {
             return Err(format!(
                 "height: {} px is outside 16 to 16384",

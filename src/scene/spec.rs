@@ -178,11 +178,8 @@ pub fn parse(text: &str, origin: &Origin<'_>) -> Result<Scene> {
     let fov = c.fov_y_deg.unwrap_or(60.0);
     let near = c.near_m.unwrap_or(0.05);
     let far = c.far_m.unwrap_or(1000.0);
-    if !(fov > 0.0 && fov < 179.0) {
-        return Err(ctx.error_at(
-            camera_span.clone(),
-            format!("[camera] fov_y_deg = {fov}: must lie in (0, 179) degrees"),
-        ));
+    if let Err(e) = crate::limits::FOV_Y_DEG.check("[camera] fov_y_deg =", fov) {
+        return Err(ctx.error_at(camera_span.clone(), e));
     }
     if !(finite_positive(near) && finite_positive(far) && far > near) {
         return Err(ctx.error_at(
@@ -248,11 +245,8 @@ pub fn parse(text: &str, origin: &Origin<'_>) -> Result<Scene> {
     let pupil_mm = match &file.pupil_mm {
         Some(p) => {
             let v = *p.get_ref();
-            if !(v > 0.5 && v < 10.0) {
-                return Err(ctx.error_at(
-                    p.span(),
-                    format!("pupil_mm = {v}: must lie in (0.5, 10) mm"),
-                ));
+            if let Err(e) = crate::limits::PUPIL_MM.check("pupil_mm =", v) {
+                return Err(ctx.error_at(p.span(), e));
             }
             Some(v)
         }
@@ -445,9 +439,9 @@ fn timeline(ctx: &Ctx<'_>, keys: &[Spanned<KeyframeSpec>]) -> Result<Timeline> {
                 }
             }
             if let Some(f) = c.fov_y_deg {
-                if !(f > 0.0 && f < 179.0) {
-                    return Err(err(format!("fov_y_deg = {f}: must lie in (0, 179)")));
-                }
+                crate::limits::FOV_Y_DEG
+                    .check("fov_y_deg =", f)
+                    .map_err(&err)?;
                 fov.push((t, f));
             }
         }
@@ -462,9 +456,9 @@ fn timeline(ctx: &Ctx<'_>, keys: &[Spanned<KeyframeSpec>]) -> Result<Timeline> {
             }
         }
         if let Some(p) = k.pupil_mm {
-            if !(p > 0.5 && p < 10.0) {
-                return Err(err(format!("pupil_mm = {p}: must lie in (0.5, 10) mm")));
-            }
+            crate::limits::PUPIL_MM
+                .check("pupil_mm =", p)
+                .map_err(&err)?;
             pupil.push((t, p));
         }
         if let Some(l) = k.luminance_cd_m2 {

@@ -180,18 +180,12 @@ pub enum EstimateError {
 /// Checks the target the way the CLI promises: pupil 1–9 mm, wavelength 380–1000 nm,
 /// finite coefficients of existing terms up to order 10.
 pub fn check_target(target: &ZernikeSet) -> Result<(), EstimateError> {
-    let p = target.pupil_diameter_mm;
-    if !(p.is_finite() && (1.0..=9.0).contains(&p)) {
-        return Err(EstimateError::Input(format!(
-            "pupil diameter {p} mm is not allowed; need 1 to 9 mm"
-        )));
-    }
-    let w = target.wavelength_nm;
-    if !(w.is_finite() && (380.0..=1000.0).contains(&w)) {
-        return Err(EstimateError::Input(format!(
-            "wavelength {w} nm is not allowed; need 380 to 1000 nm"
-        )));
-    }
+    crate::limits::PUPIL_MM
+        .check("pupil diameter", target.pupil_diameter_mm)
+        .map_err(EstimateError::Input)?;
+    crate::limits::WAVELENGTH_NM
+        .check("wavelength", target.wavelength_nm)
+        .map_err(EstimateError::Input)?;
     for &(n, m, v) in &target.coefficients {
         if n > 10 || !crate::optics::zernike::is_valid_nm(n, m) {
             return Err(EstimateError::Input(format!(

@@ -485,12 +485,9 @@ impl Splatter {
                 input.depth_m.len()
             )));
         }
-        if !(input.fov_y_deg.is_finite() && input.fov_y_deg > 0.1 && input.fov_y_deg < 170.0) {
-            return Err(crate::Error::input(format!(
-                "vertical field of view {} degrees is outside 0.1 to 170",
-                input.fov_y_deg
-            )));
-        }
+        crate::limits::FOV_Y_DEG
+            .check("vertical field of view", input.fov_y_deg)
+            .map_err(crate::Error::input)?;
         if !(view.pupil_mm.is_finite() && view.pupil_mm > 0.0 && view.focus_d.is_finite()) {
             return Err(crate::Error::input(format!(
                 "pupil {} mm / focus {} D must be finite, pupil positive",
