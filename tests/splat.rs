@@ -654,3 +654,71 @@ fn tile_sizes_agree_and_frames_are_deterministic() {
     assert!(err.to_string().contains("tile size 12"), "{err}");
     common::finish(ctx);
 }
+
+/// A frame whose fragments exceed one storage-buffer binding is bound as four ranges of one
+/// buffer (how a 3840×2160 frame fits lavapipe's 128 MiB bindings): every pass, merging
+/// included, must read and write across the range boundaries exactly as through one binding.
+#[test]
+fn fragments_split_over_four_bindings_render_the_same() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.2, 5.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let scene = Scene::new(96, 64, |x, y| {
+        if (40..70).contains(&x) && (10..40).contains(&y) {
+            (texture(x, y, 3.0), 0.4)
+        } else if x < 30 {
+            ([0.2, 0.4, 0.6], 0.5)
+        } else {
+            ([0.7, 0.7, 0.7], 2.0)
+        }
+    });
+    let merge = MergeSettings {
+        levels: 2,
+        ..MergeSettings::default()
+    };
+    let whole = SplatSettings {
+        merge,
+        ..SplatSettings::default()
+    };
+    let one = splat(&ctx, &grid, whole, &scene, true);
+    let fragment_bytes = 48u64;
+    let pixels = 96 * 64;
+    // A third of the frame per binding: four ranges of 1536 fragments.
+    let split = SplatSettings {
+        max_fragment_binding_bytes: pixels * fragment_bytes / 3,
+        ..whole
+    };
+    let four = splat(&ctx, &grid, split, &scene, true);
+    let (a, b) = (one.intermediates.unwrap(), four.intermediates.unwrap());
+    assert_eq!(a.fragments.len(), b.fragments.len());
+    for (i, (x, y)) in a.fragments.iter().zip(&b.fragments).enumerate() {
+        assert_eq!(
+            bytemuck::bytes_of(x),
+            bytemuck::bytes_of(y),
+            "fragment {i} differs when split"
+        );
+    }
+    assert_eq!(one.color, four.color, "the split must not change the image");
+    assert!(one.stats.live_fragments < pixels, "merging ran");
+    // Past four ranges the frame is refused with the device's limit in the message.
+    let too_small = SplatSettings {
+        max_fragment_binding_bytes: pixels * fragment_bytes / 5,
+        ..whole
+    };
+    let err = Splatter::new(&ctx, grid.clone(), too_small)
+        .unwrap()
+        .render(
+            &scene.input(),
+            ViewState {
+                pupil_mm: 4.0,
+                focus_d: grid.focus_d[0],
+            },
+            false,
+        )
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("storage-buffer bindings"), "{err}");
+    common::finish(ctx);
+}

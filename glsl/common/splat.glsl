@@ -38,11 +38,42 @@ layout(push_constant) uniform FrameParams {
     uint wide_field;       // 1 = vergence along rays and kernels at the local pinhole scale
     uint entry_capacity;   // entries the list buffer holds: lists past it are not touched
     float saturation_epsilon; // convolution stops once every pixel's coverage is ≥ 1 − ε
-    uint pad0;
+    uint fragments_per_chunk; // see FRAGMENT_BUFFERS
     uint pad1;
     uvec4 pass_u;          // pass-specific values (see each pass)
     vec4 pass_f;
 } frame;
+
+// A frame's fragments live in one buffer, bound as four consecutive ranges of
+// frame.fragments_per_chunk fragments each (src/render/splat/fragments.rs): a 3840×2160 frame
+// holds 380 MiB of fragments and a device may bind as little as 128 MiB per binding. A pass
+// declares the four bindings with FRAGMENT_BUFFERS and reads and writes through
+// load_fragment / store_fragment (FRAGMENT_LOAD, FRAGMENT_STORE).
+#define FRAGMENT_BUFFERS(B0, B1, B2, B3, QUALIFIER)                                          \
+    layout(std430, binding = B0) QUALIFIER buffer Fragments0 { Fragment fragments0[]; };     \
+    layout(std430, binding = B1) QUALIFIER buffer Fragments1 { Fragment fragments1[]; };     \
+    layout(std430, binding = B2) QUALIFIER buffer Fragments2 { Fragment fragments2[]; };     \
+    layout(std430, binding = B3) QUALIFIER buffer Fragments3 { Fragment fragments3[]; };
+
+#define FRAGMENT_LOAD                                                                        \
+    Fragment load_fragment(uint i) {                                                         \
+        uint chunk = i / frame.fragments_per_chunk;                                          \
+        uint j = i - chunk * frame.fragments_per_chunk;                                      \
+        if (chunk == 0u) return fragments0[j];                                               \
+        if (chunk == 1u) return fragments1[j];                                               \
+        if (chunk == 2u) return fragments2[j];                                               \
+        return fragments3[j];                                                                \
+    }
+
+#define FRAGMENT_STORE                                                                       \
+    void store_fragment(uint i, Fragment f) {                                                \
+        uint chunk = i / frame.fragments_per_chunk;                                          \
+        uint j = i - chunk * frame.fragments_per_chunk;                                      \
+        if (chunk == 0u) fragments0[j] = f;                                                  \
+        else if (chunk == 1u) fragments1[j] = f;                                             \
+        else if (chunk == 2u) fragments2[j] = f;                                             \
+        else fragments3[j] = f;                                                              \
+    }
 
 // The kernel layout at a screen point (see src/render/projection.rs): xy = radial unit
 // vector, z = cos θ. A screen offset d maps to the kernel offset

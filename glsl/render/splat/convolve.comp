@@ -14,7 +14,8 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
-layout(std430, binding = 1) readonly buffer Fragments { Fragment fragments[]; };
+FRAGMENT_BUFFERS(1, 6, 7, 8, readonly)
+FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 3) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 4) readonly buffer Entries { uvec2 entries[]; };
@@ -112,7 +113,7 @@ void main() {
             unsaturated = 0u;
         }
         if (start + local_index < n) {
-            Fragment f = fragments[entries[base + start + local_index].y];
+            Fragment f = load_fragment(entries[base + start + local_index].y);
             batch[local_index] = f;
             vec3 s = local_scale(f.center);
             // The largest channel radius decides how much of the local scale applies.

@@ -10,7 +10,8 @@ layout(binding = 0, rgba32f) readonly uniform image2D color_in;
 layout(binding = 1, r32f) readonly uniform image2D depth_in;
 // Natural radius per object distance, per channel (xyz), of this frame's blended kernels.
 layout(std430, binding = 2) readonly buffer Radii { vec4 radii[]; };
-layout(std430, binding = 3) writeonly buffer Fragments { Fragment fragments[]; };
+FRAGMENT_BUFFERS(3, 4, 5, 6, writeonly)
+FRAGMENT_STORE
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
@@ -40,5 +41,5 @@ void main() {
     f.center = vec2(p) + 0.5;
     f.size = 1u;
     f.dioptre = dioptre;
-    fragments[p.y * frame.width + p.x] = f;
+    store_fragment(p.y * frame.width + p.x, f);
 }

@@ -11,7 +11,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 // Per object distance: natural radius per channel (xyz) and the smallest core radius (w).
 layout(std430, binding = 0) readonly buffer Radii { vec4 radii[]; };
-layout(std430, binding = 1) buffer Fragments { Fragment fragments[]; };
+FRAGMENT_BUFFERS(1, 2, 3, 4, )
+FRAGMENT_LOAD
+FRAGMENT_STORE
 
 // Core radius (√2·r50) of a fragment's kernels, interpolated like its radius.
 float core_radius(Fragment f) {
@@ -38,7 +40,7 @@ void main() {
     ids[3] = ids[2] + child;
     Fragment f[4];
     for (int k = 0; k < 4; k++) {
-        f[k] = fragments[ids[k]];
+        f[k] = load_fragment(ids[k]);
         if (f[k].size != child) {
             return; // a child was not (or differently) merged
         }
@@ -81,8 +83,9 @@ void main() {
     m.center = vec2(origin) + 0.5 * float(size);
     m.size = size;
     m.dioptre = 0.25 * (f[0].dioptre + f[1].dioptre + f[2].dioptre + f[3].dioptre);
-    fragments[ids[0]] = m;
+    store_fragment(ids[0], m);
     for (int k = 1; k < 4; k++) {
-        fragments[ids[k]].size = 0u;
+        f[k].size = 0u;
+        store_fragment(ids[k], f[k]);
     }
 }

@@ -6,7 +6,8 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = 0) readonly buffer Fragments { Fragment fragments[]; };
+FRAGMENT_BUFFERS(0, 2, 3, 4, readonly)
+FRAGMENT_LOAD
 layout(std430, binding = 1) buffer Counts { uint counts[]; };
 
 shared uint live_in_group;
@@ -16,7 +17,7 @@ void main() {
     barrier();
     uvec2 p = gl_GlobalInvocationID.xy;
     if (p.x < frame.width && p.y < frame.height) {
-        Fragment f = fragments[p.y * frame.width + p.x];
+        Fragment f = load_fragment(p.y * frame.width + p.x);
         if (f.size != 0u) {
             atomicAdd(live_in_group, 1u);
             ivec4 tiles = fragment_tiles(f);

@@ -7,7 +7,8 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(std430, binding = 0) readonly buffer Fragments { Fragment fragments[]; };
+FRAGMENT_BUFFERS(0, 4, 5, 6, readonly)
+FRAGMENT_LOAD
 layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 2) buffer Cursors { uint cursors[]; };
 layout(std430, binding = 3) writeonly buffer Entries { uvec2 entries[]; };
@@ -18,7 +19,7 @@ void main() {
         return;
     }
     uint index = p.y * frame.width + p.x;
-    Fragment f = fragments[index];
+    Fragment f = load_fragment(index);
     if (f.size == 0u) {
         return;
     }

@@ -6,6 +6,7 @@ use crate::gpu::{
 };
 
 use super::tile_fill::per_tile_groups;
+use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::FrameParams;
 
 pub(super) struct ConvolvePass {
@@ -16,14 +17,15 @@ impl ConvolvePass {
     pub fn new(ctx: &Context, tile_size: u32) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
-                .bindings(&[
-                    BindingKind::SampledImage,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageImage,
-                ])
+                .bindings(&kinds_with_fragments(
+                    &[BindingKind::SampledImage],
+                    &[
+                        BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
+                        BindingKind::StorageImage,
+                    ],
+                ))
                 .push_constants::<FrameParams>()
                 .specialize(0, tile_size)
                 .build(ctx)?;
@@ -37,7 +39,7 @@ impl ConvolvePass {
         params: &FrameParams,
         band_tiles: u32,
         psf: (&Image, &Sampler),
-        fragments: &Buffer,
+        fragments: &FragmentStore,
         counts: &Buffer,
         offsets: &Buffer,
         entries: &Buffer,
@@ -45,14 +47,15 @@ impl ConvolvePass {
     ) -> GpuResult<()> {
         rec.dispatch(
             &self.pipeline,
-            &[
-                Binding::Sampled(psf.0, psf.1),
-                Binding::Buffer(fragments),
-                Binding::Buffer(counts),
-                Binding::Buffer(offsets),
-                Binding::Buffer(entries),
-                Binding::Storage(output),
-            ],
+            &fragments.bind_with(
+                &[Binding::Sampled(psf.0, psf.1)],
+                &[
+                    Binding::Buffer(counts),
+                    Binding::Buffer(offsets),
+                    Binding::Buffer(entries),
+                    Binding::Storage(output),
+                ],
+            ),
             params,
             per_tile_groups(band_tiles),
         )

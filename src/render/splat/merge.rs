@@ -3,6 +3,7 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
+use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::FrameParams;
 
 pub(super) struct MergePass {
@@ -12,7 +13,7 @@ pub(super) struct MergePass {
 impl MergePass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("merge", crate::shaders::RENDER_SPLAT_MERGE_COMP)
-            .bindings(&[BindingKind::StorageBuffer, BindingKind::StorageBuffer])
+            .bindings(&kinds_with_fragments(&[BindingKind::StorageBuffer], &[]))
             .push_constants::<FrameParams>()
             .build(ctx)?;
         Ok(MergePass { pipeline })
@@ -25,7 +26,7 @@ impl MergePass {
         params: &FrameParams,
         levels: u32,
         radii: &Buffer,
-        fragments: &Buffer,
+        fragments: &FragmentStore,
     ) -> GpuResult<()> {
         for level in 1..=levels {
             let size = 1u32 << level;
@@ -34,7 +35,7 @@ impl MergePass {
             let blocks = [params.width / size, params.height / size];
             rec.dispatch(
                 &self.pipeline,
-                &[Binding::Buffer(radii), Binding::Buffer(fragments)],
+                &fragments.bind_with(&[Binding::Buffer(radii)], &[]),
                 &p,
                 [blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1],
             )?;

@@ -66,7 +66,9 @@ pub(crate) struct FrameParams {
     pub wide_field: u32,
     pub entry_capacity: u32,
     pub saturation_epsilon: f32,
-    pub pad: [u32; 2],
+    /// Fragments per bound range of the fragment buffer (`fragments::FragmentStore`).
+    pub fragments_per_chunk: u32,
+    pub pad: u32,
     pub pass_u: [u32; 4],
     pub pass_f: [f32; 4],
 }
@@ -105,6 +107,9 @@ pub struct SplatSettings {
     /// Upper bound on the tile-list buffer (bytes); bands are used beyond it. The device's
     /// storage-buffer binding limit applies as well.
     pub max_list_bytes: u64,
+    /// Upper bound on one binding of the fragment buffer (bytes); the device's limit applies
+    /// as well. A frame whose fragments exceed it is bound as up to four ranges.
+    pub max_fragment_binding_bytes: u64,
     /// How fragments combine, and the wide-field geometry.
     pub blend: BlendSettings,
     /// The convolution stops walking a tile's list once every pixel's coverage reaches
@@ -123,6 +128,7 @@ impl Default for SplatSettings {
             texture_format: PsfTextureFormat::Rgba16Float,
             merge: MergeSettings::default(),
             max_list_bytes: 1 << 30,
+            max_fragment_binding_bytes: u64::MAX,
             blend: BlendSettings::default(),
             saturation_epsilon: DEFAULT_SATURATION_EPSILON,
             steady_state: true,
@@ -234,7 +240,7 @@ struct FrameResources {
     color_in: Image,
     depth_in: Image,
     color_out: Image,
-    fragments: Buffer,
+    fragments: fragments::FragmentStore,
     counts: Buffer,
     cursors: Buffer,
     offsets: Buffer,
@@ -276,7 +282,7 @@ pub struct Splatter {
     convolve: convolve::ConvolvePass,
 }
 
-const FRAGMENT_BYTES: u64 = std::mem::size_of::<Fragment>() as u64;
+pub(super) const FRAGMENT_BYTES: u64 = std::mem::size_of::<Fragment>() as u64;
 const ENTRY_BYTES: u64 = 8;
 
 fn binding_limit(ctx: &Context) -> u64 {
@@ -361,16 +367,16 @@ impl Splatter {
         }
         let ctx = &self.ctx;
         let pixels = u64::from(width) * u64::from(height);
-        let limit = binding_limit(ctx);
-        if pixels * FRAGMENT_BYTES > limit {
+        let limit = binding_limit(ctx).min(self.settings.max_fragment_binding_bytes);
+        let Some(per_chunk) = fragments::fragments_per_chunk(pixels, limit) else {
             return Err(crate::Error::input(format!(
-                "a {width}×{height} frame needs {} MiB of fragments, over this device's {} MiB storage-buffer \
-                 binding limit; render at most {} pixels per frame on this device",
+                "a {width}×{height} frame needs {} MiB of fragments, over four of this device's {} MiB \
+                 storage-buffer bindings; render at most {} pixels per frame on this device",
                 (pixels * FRAGMENT_BYTES) >> 20,
                 limit >> 20,
-                limit / FRAGMENT_BYTES
+                fragments::FRAGMENT_CHUNKS * (limit / FRAGMENT_BYTES)
             )));
-        }
+        };
         let tile = self.settings.tile_size;
         let (tiles_x, tiles_y) = (width.div_ceil(tile), height.div_ceil(tile));
         let tiles = u64::from(tiles_x) * u64::from(tiles_y);
@@ -404,7 +410,7 @@ impl Splatter {
                 TexelFormat::Rgba32Float,
                 storage,
             )?,
-            fragments: Buffer::new(ctx, "fragments", pixels * FRAGMENT_BYTES, Residency::Device)?,
+            fragments: fragments::FragmentStore::new(ctx, pixels, per_chunk)?,
             counts: Buffer::new(ctx, "tile counts", (tiles + 1) * 4, Residency::Device)?,
             cursors: Buffer::new(ctx, "tile cursors", tiles * 4, Residency::Device)?,
             offsets: Buffer::new(ctx, "tile offsets", (tiles + 1) * 4, Residency::Device)?,
@@ -463,7 +469,8 @@ impl Splatter {
             wide_field: u32::from(self.settings.blend.wide_field),
             entry_capacity: 0,
             saturation_epsilon: self.settings.saturation_epsilon,
-            pad: [0; 2],
+            fragments_per_chunk: frame.fragments.per_chunk,
+            pad: 0,
             pass_u: [0; 4],
             pass_f: [0.0; 4],
         }
@@ -655,7 +662,7 @@ impl Splatter {
         let intermediates = if keep_intermediates {
             let mut all_entries: Vec<[u32; 2]> = entries.read(&ctx)?;
             all_entries.truncate(if bands.len() == 1 { total as usize } else { 0 });
-            let fragments: Vec<Fragment> = frame.fragments.read(&ctx)?;
+            let fragments: Vec<Fragment> = frame.fragments.buffer.read(&ctx)?;
             Some(SplatIntermediates {
                 fragments,
                 counts,

@@ -3,6 +3,7 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
+use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::FrameParams;
 
 pub(super) struct TileCountPass {
@@ -13,7 +14,7 @@ impl TileCountPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
-                .bindings(&[BindingKind::StorageBuffer, BindingKind::StorageBuffer])
+                .bindings(&kinds_with_fragments(&[], &[BindingKind::StorageBuffer]))
                 .push_constants::<FrameParams>()
                 .build(ctx)?;
         Ok(TileCountPass { pipeline })
@@ -24,12 +25,12 @@ impl TileCountPass {
         &self,
         rec: &mut Recorder<'_>,
         params: &FrameParams,
-        fragments: &Buffer,
+        fragments: &FragmentStore,
         counts: &Buffer,
     ) -> GpuResult<()> {
         rec.dispatch(
             &self.pipeline,
-            &[Binding::Buffer(fragments), Binding::Buffer(counts)],
+            &fragments.bind_with(&[], &[Binding::Buffer(counts)]),
             params,
             [params.width.div_ceil(8), params.height.div_ceil(8), 1],
         )

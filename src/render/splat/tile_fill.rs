@@ -3,6 +3,7 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
+use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::FrameParams;
 
 pub(super) struct TileFillPass {
@@ -13,12 +14,14 @@ impl TileFillPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("tile fill", crate::shaders::RENDER_SPLAT_TILE_FILL_COMP)
-                .bindings(&[
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                ])
+                .bindings(&kinds_with_fragments(
+                    &[],
+                    &[
+                        BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
+                    ],
+                ))
                 .push_constants::<FrameParams>()
                 .build(ctx)?;
         Ok(TileFillPass { pipeline })
@@ -29,19 +32,21 @@ impl TileFillPass {
         &self,
         rec: &mut Recorder<'_>,
         params: &FrameParams,
-        fragments: &Buffer,
+        fragments: &FragmentStore,
         offsets: &Buffer,
         cursors: &Buffer,
         entries: &Buffer,
     ) -> GpuResult<()> {
         rec.dispatch(
             &self.pipeline,
-            &[
-                Binding::Buffer(fragments),
-                Binding::Buffer(offsets),
-                Binding::Buffer(cursors),
-                Binding::Buffer(entries),
-            ],
+            &fragments.bind_with(
+                &[],
+                &[
+                    Binding::Buffer(offsets),
+                    Binding::Buffer(cursors),
+                    Binding::Buffer(entries),
+                ],
+            ),
             params,
             [params.width.div_ceil(8), params.height.div_ceil(8), 1],
         )
