@@ -97,6 +97,10 @@ fn steady_frames_are_one_submission_without_allocations() {
         eprintln!("steady frame: {:?}", next.stats);
         assert_eq!(next.stats.submissions, 1);
         assert_eq!(next.stats.allocations, 0);
+        assert_eq!(
+            next.stats.submission_objects, 0,
+            "a steady frame reuses its command buffer, fence and pools"
+        );
         let image_bytes = u64::from(W * H) * 16;
         assert_eq!(next.stats.readback_bytes, image_bytes + 8);
         assert!(next.stats.upload_bytes <= u64::from(W * H) * 20 + 11 * 16);

@@ -138,6 +138,8 @@ struct Report {
 struct Counters {
     submissions: u32,
     allocations: u32,
+    /// Vulkan objects created for the frame's submissions (0: all reused).
+    submission_objects: u64,
     upload_bytes: u64,
     readback_bytes: u64,
 }
@@ -197,6 +199,7 @@ fn time_frames(
             t.counters = Counters {
                 submissions: s.submissions,
                 allocations: s.allocations,
+                submission_objects: s.submission_objects,
                 upload_bytes: s.upload_bytes,
                 readback_bytes: s.readback_bytes,
             };
@@ -412,8 +415,8 @@ fn print_table(r: &Report) {
     );
     let c = &r.counters;
     println!(
-        "  per frame: {} submission(s), {} allocation(s), {} B up, {} B down",
-        c.submissions, c.allocations, c.upload_bytes, c.readback_bytes
+        "  per frame: {} submission(s), {} allocation(s), {} Vulkan object(s) created, {} B up, {} B down",
+        c.submissions, c.allocations, c.submission_objects, c.upload_bytes, c.readback_bytes
     );
     if let Some(b) = &r.baseline {
         println!();

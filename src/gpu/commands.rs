@@ -8,11 +8,7 @@ use super::context::Context;
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::Image;
 use super::pipeline::{Binding, BindingKind, ComputePipeline, PipelineParts};
-
-/// Timestamp pairs per submission; more passes than this in one submission are not timed.
-const MAX_TIMED_PASSES: u32 = 64;
-/// Descriptor sets per pool before the recorder opens another pool.
-const SETS_PER_POOL: u32 = 256;
+use super::submit_slot::{SubmitSlot, MAX_TIMED_PASSES, SETS_PER_POOL};
 
 /// GPU time of each named pass of one submission, in recording order.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -50,7 +46,9 @@ impl Timings {
 pub struct Recorder<'a> {
     ctx: &'a Context,
     pub(super) cmd: vk::CommandBuffer,
-    descriptor_pools: Vec<vk::DescriptorPool>,
+    slot: Option<SubmitSlot>,
+    /// Descriptor pools of the slot filled so far, and sets left in the last.
+    pools_used: usize,
     sets_left_in_pool: u32,
     query_pool: Option<vk::QueryPool>,
     next_query: u32,
@@ -70,39 +68,14 @@ impl Context {
         F: FnOnce(&mut Recorder<'_>) -> GpuResult<()>,
     {
         let shared = &self.shared;
-        let device = &shared.device;
-        let pool = *shared
-            .command_pool
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        // The command pool is externally synchronised: hold its lock while allocating.
-        let cmd = {
-            let _guard = shared
-                .command_pool
-                .lock()
-                .unwrap_or_else(|e| e.into_inner());
-            // SAFETY: the pool belongs to this device and is locked.
-            unsafe { device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0]
-        };
-        let query_pool = if shared.timestamp_valid_bits > 0 {
-            let info = vk::QueryPoolCreateInfo::default()
-                .query_type(vk::QueryType::TIMESTAMP)
-                .query_count(2 * MAX_TIMED_PASSES);
-            // SAFETY: valid create info on a live device.
-            unsafe { device.create_query_pool(&info, None) }.ok()
-        } else {
-            None
-        };
+        let slot = SubmitSlot::take(shared)?;
         let mut recorder = Recorder {
             ctx: self,
-            cmd,
-            descriptor_pools: Vec::new(),
+            cmd: slot.cmd,
+            query_pool: slot.query_pool,
+            slot: Some(slot),
+            pools_used: 0,
             sets_left_in_pool: 0,
-            query_pool,
             next_query: 0,
             open_pass: None,
             passes: Vec::new(),
@@ -111,13 +84,12 @@ impl Context {
         };
         let result = recorder.record_and_run(record);
         let timings = result.and_then(|()| recorder.read_timings());
-        recorder.release();
-        let _guard = shared
-            .command_pool
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        // SAFETY: the submission has completed (or was never made); the pool is locked.
-        unsafe { device.free_command_buffers(pool, &[cmd]) };
+        // A failed recording or submission may leave the command buffer pending or half
+        // recorded: the slot is then destroyed (after an idle wait) rather than reused.
+        if let Some(slot) = recorder.slot.take() {
+            slot.give_back(shared, timings.is_ok());
+        }
+        recorder.keep_alive.clear();
         let timings = timings?;
         shared.check_validation()?;
         Ok(timings)
@@ -156,9 +128,7 @@ impl<'a> Recorder<'a> {
         unsafe { device.end_command_buffer(self.cmd) }.vk("vkEndCommandBuffer")?;
         // Catch recording errors (bad bindings, bad barriers) before the driver sees them.
         self.ctx.shared.check_validation()?;
-        let fence_info = vk::FenceCreateInfo::default();
-        // SAFETY: valid create info; the fence is destroyed below on every path.
-        let fence = unsafe { device.create_fence(&fence_info, None) }.vk("vkCreateFence")?;
+        let fence = self.slot.as_ref().expect("slot held while recording").fence;
         let cmds = [self.cmd];
         let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
         let outcome = {
@@ -173,11 +143,10 @@ impl<'a> Recorder<'a> {
             unsafe { device.queue_submit(*queue, &submit, fence) }.vk("vkQueueSubmit")
         }
         .and_then(|()| {
-            // SAFETY: the fence belongs to this device.
+            // SAFETY: the fence belongs to this device and is reset (a slot's fence is reset
+            // when the slot is given back).
             unsafe { device.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences")
         });
-        // SAFETY: the fence is signalled or was never submitted.
-        unsafe { device.destroy_fence(fence, None) };
         outcome
     }
 
@@ -219,20 +188,6 @@ impl<'a> Recorder<'a> {
             })
             .collect();
         Ok(Timings { passes })
-    }
-
-    fn release(&mut self) {
-        let device = self.device().clone();
-        // SAFETY: the submission has completed; these objects are used by nothing else.
-        unsafe {
-            for pool in self.descriptor_pools.drain(..) {
-                device.destroy_descriptor_pool(pool, None);
-            }
-            if let Some(pool) = self.query_pool.take() {
-                device.destroy_query_pool(pool, None);
-            }
-        }
-        self.keep_alive.clear();
     }
 
     pub fn context(&self) -> &Context {
@@ -461,36 +416,19 @@ impl<'a> Recorder<'a> {
         set_layout: vk::DescriptorSetLayout,
     ) -> GpuResult<vk::DescriptorSet> {
         if self.sets_left_in_pool == 0 {
-            let sizes = [
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::STORAGE_BUFFER,
-                    descriptor_count: SETS_PER_POOL * 8,
-                },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::UNIFORM_BUFFER,
-                    descriptor_count: SETS_PER_POOL * 2,
-                },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                    descriptor_count: SETS_PER_POOL * 4,
-                },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::STORAGE_IMAGE,
-                    descriptor_count: SETS_PER_POOL * 4,
-                },
-            ];
-            let info = vk::DescriptorPoolCreateInfo::default()
-                .max_sets(SETS_PER_POOL)
-                .pool_sizes(&sizes);
-            // SAFETY: valid create info; destroyed in release().
-            let pool = unsafe { self.device().create_descriptor_pool(&info, None) }
-                .vk("vkCreateDescriptorPool")?;
-            self.descriptor_pools.push(pool);
+            let slot = self.slot.as_mut().expect("slot held while recording");
+            slot.descriptor_pool(&self.ctx.shared, self.pools_used)?;
+            self.pools_used += 1;
             self.sets_left_in_pool = SETS_PER_POOL;
         }
         let layouts = [set_layout];
         let info = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(*self.descriptor_pools.last().expect("pool just ensured"))
+            .descriptor_pool(
+                self.slot
+                    .as_ref()
+                    .expect("slot held while recording")
+                    .descriptor_pools[self.pools_used - 1],
+            )
             .set_layouts(&layouts);
         // SAFETY: the pool has room (at most 8 storage buffers per set are assumed; a pass with
         // more bindings of one kind would fail here with a Vulkan error, not UB).

@@ -191,6 +191,10 @@ pub(crate) struct DeviceShared {
     pub(crate) queue: Mutex<vk::Queue>,
     pub(crate) queue_family: u32,
     pub(crate) command_pool: Mutex<vk::CommandPool>,
+    /// Submission objects kept between submissions (`submit_slot`).
+    pub(crate) submit_slots: Mutex<Vec<super::submit_slot::SubmitSlot>>,
+    /// Vulkan objects created for submissions since the device was opened.
+    pub(crate) objects_created: std::sync::atomic::AtomicU64,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) properties: vk::PhysicalDeviceProperties,
     pub(crate) timestamp_valid_bits: u32,
@@ -201,6 +205,19 @@ pub(crate) struct DeviceShared {
 }
 
 impl DeviceShared {
+    pub(crate) fn lock_slots(&self) -> MutexGuard<'_, Vec<super::submit_slot::SubmitSlot>> {
+        self.submit_slots.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub(crate) fn lock_command_pool(&self) -> MutexGuard<'_, vk::CommandPool> {
+        self.command_pool.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub(crate) fn count_created(&self, n: u64) {
+        self.objects_created
+            .fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+    }
+
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
         self.allocator.lock().unwrap_or_else(|e| e.into_inner())
     }
@@ -225,6 +242,14 @@ impl Drop for DeviceShared {
         // device is idle after the wait, and objects are destroyed children first.
         unsafe {
             let _ = self.device.device_wait_idle();
+            let slots = std::mem::take(
+                self.submit_slots
+                    .get_mut()
+                    .unwrap_or_else(|e| e.into_inner()),
+            );
+            for mut slot in slots {
+                slot.destroy(self);
+            }
             ManuallyDrop::drop(&mut self.allocator);
             let pool = *self
                 .command_pool
@@ -574,6 +599,8 @@ impl Context {
                 queue: Mutex::new(queue),
                 queue_family,
                 command_pool: Mutex::new(pool),
+                submit_slots: Mutex::new(Vec::new()),
+                objects_created: std::sync::atomic::AtomicU64::new(0),
                 allocator: ManuallyDrop::new(Mutex::new(allocator)),
                 properties,
                 timestamp_valid_bits: families[queue_family as usize].timestamp_valid_bits,
@@ -591,6 +618,14 @@ impl Context {
 
     pub fn limits(&self) -> &vk::PhysicalDeviceLimits {
         &self.shared.properties.limits
+    }
+
+    /// Vulkan objects (command buffers, fences, query and descriptor pools) created for
+    /// submissions so far: constant across steady-state frames, which reuse them.
+    pub fn submission_objects_created(&self) -> u64 {
+        self.shared
+            .objects_created
+            .load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Whether the validation layer is active on this context.

@@ -10,6 +10,7 @@ mod graphics;
 mod image;
 mod pipeline;
 mod render_pass;
+mod submit_slot;
 pub mod texture_probe;
 
 pub use buffer::{Buffer, Residency};

@@ -5,8 +5,8 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Sampler,
 };
 
-use super::tile_fill::per_tile_groups;
 use super::fragments::{kinds_with_fragments, FragmentStore};
+use super::tile_fill::per_tile_groups;
 use super::FrameParams;
 
 pub(super) struct ConvolvePass {

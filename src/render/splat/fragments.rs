@@ -2,8 +2,7 @@
 //! See glsl/render/splat/fragments.comp.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder,
-    Residency,
+    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
 };
 
 use super::{FrameParams, FRAGMENT_BYTES};
@@ -84,7 +83,10 @@ impl FragmentStore {
 }
 
 /// The binding kinds of a pass whose fragment ranges sit after `before` and before `after`.
-pub(super) fn kinds_with_fragments(before: &[BindingKind], after: &[BindingKind]) -> Vec<BindingKind> {
+pub(super) fn kinds_with_fragments(
+    before: &[BindingKind],
+    after: &[BindingKind],
+) -> Vec<BindingKind> {
     let mut all = before.to_vec();
     all.push(BindingKind::StorageBuffer);
     all.extend_from_slice(after);

@@ -211,6 +211,9 @@ pub struct SplatStats {
     /// counters: a steady-state frame is one submission and no allocation).
     pub submissions: u32,
     pub allocations: u32,
+    /// Vulkan objects (command buffers, fences, query and descriptor pools) created for this
+    /// frame's submissions: 0 once the device's submission objects are warm.
+    pub submission_objects: u64,
     pub upload_bytes: u64,
     pub readback_bytes: u64,
 }
@@ -502,6 +505,7 @@ impl Splatter {
             )));
         }
         let allocations_before = self.allocations;
+        let objects_before = self.ctx.submission_objects_created();
         self.ensure_frame(w, h)?;
         let ctx = self.ctx.clone();
         let blend = self.grid.blend(view.pupil_mm, view.focus_d);
@@ -577,6 +581,7 @@ impl Splatter {
                     bands: 1,
                     submissions,
                     allocations: self.allocations - allocations_before,
+                    submission_objects: ctx.submission_objects_created() - objects_before,
                     upload_bytes,
                     readback_bytes: output_bytes + 8,
                 };
@@ -656,6 +661,7 @@ impl Splatter {
             bands: bands.len() as u32,
             submissions,
             allocations: self.allocations - allocations_before,
+            submission_objects: ctx.submission_objects_created() - objects_before,
             upload_bytes,
             readback_bytes: output_bytes + u64::from(2 * (tiles + 1)) * 4,
         };
