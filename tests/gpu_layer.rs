@@ -383,3 +383,104 @@ fn unknown_device_is_rejected_with_the_list() {
         "{text}"
     );
 }
+
+/// Barriers come from what each command declares it reads and writes (the shader's
+/// readonly/writeonly, reflected): two dispatches that only share a read-only input run
+/// without a barrier between them, a dispatch that reads what an earlier one wrote waits for
+/// it. Synchronization validation (on in every test) would report a missing dependency.
+/// A pass whose declared bindings or push constants disagree with its shader is refused when
+/// the pipeline is built.
+#[test]
+fn barriers_follow_declared_access_and_declarations_match_shaders() {
+    let ctx = common::gpu();
+    let kinds = [
+        BindingKind::SampledImage,
+        BindingKind::StorageBuffer,
+        BindingKind::StorageBuffer,
+    ];
+    let probe = ComputePipeline::builder("probe", ocular::shaders::GPU_TEXTURE_PROBE_COMP)
+        .bindings(&kinds)
+        .push_constants::<u32>()
+        .build(&ctx)
+        .unwrap();
+    let image = Image::new_3d(
+        &ctx,
+        "v",
+        [4, 4, 4],
+        TexelFormat::Rgba32Float,
+        ImageUsage::SAMPLED,
+    )
+    .unwrap();
+    let sampler = Sampler::linear(&ctx, Edge::ZeroBorder).unwrap();
+    let buffers: Vec<Buffer> = (0..4)
+        .map(|i| Buffer::new(&ctx, &format!("b{i}"), 256, Residency::Device).unwrap())
+        .collect();
+    let [a, b, c, d] = [&buffers[0], &buffers[1], &buffers[2], &buffers[3]];
+    let mut counts = Vec::new();
+    ctx.submit(|rec| {
+        let run = |rec: &mut ocular::gpu::Recorder<'_>, input: &Buffer, output: &Buffer| {
+            rec.dispatch(
+                &probe,
+                &[
+                    Binding::Sampled(&image, &sampler),
+                    Binding::Buffer(input),
+                    Binding::Buffer(output),
+                ],
+                &16u32,
+                [1, 1, 1],
+            )
+        };
+        rec.fill_buffer(a, 0);
+        counts.push(rec.barrier_counts());
+        run(rec, a, b)?; // reads what the fill wrote: waits
+        counts.push(rec.barrier_counts());
+        run(rec, a, c)?; // shares only the read of a: no barrier
+        counts.push(rec.barrier_counts());
+        run(rec, b, d)?; // reads b, written two commands ago: waits
+        counts.push(rec.barrier_counts());
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(
+        counts,
+        [(0, 1), (1, 2), (1, 3), (2, 4)],
+        "(barriers, commands)"
+    );
+
+    let wrong_kind = ComputePipeline::builder("probe", ocular::shaders::GPU_TEXTURE_PROBE_COMP)
+        .bindings(&[
+            BindingKind::SampledImage,
+            BindingKind::StorageBuffer,
+            BindingKind::StorageImage,
+        ])
+        .push_constants::<u32>()
+        .build(&ctx)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        wrong_kind.contains("binding 2 is a StorageBuffer in the shader"),
+        "{wrong_kind}"
+    );
+    let wrong_push = ComputePipeline::builder("probe", ocular::shaders::GPU_TEXTURE_PROBE_COMP)
+        .bindings(&kinds)
+        .push_constants::<[u32; 2]>()
+        .build(&ctx)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        wrong_push.contains("push-constant block is 4 bytes, the pass's struct 8"),
+        "{wrong_push}"
+    );
+    let too_few = ComputePipeline::builder("probe", ocular::shaders::GPU_TEXTURE_PROBE_COMP)
+        .bindings(&kinds[..2])
+        .push_constants::<u32>()
+        .build(&ctx)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(too_few.contains("uses binding 2"), "{too_few}");
+    drop((probe, buffers, image, sampler));
+    common::finish(ctx);
+}

@@ -3,6 +3,7 @@
 
 use ash::vk;
 
+use super::access::{binding_access, Hazards, Resource};
 use super::buffer::Buffer;
 use super::context::Context;
 use super::error::{GpuError, GpuResult, VkContext};
@@ -58,6 +59,8 @@ pub struct Recorder<'a> {
     keep_alive: Vec<Buffer>,
     /// Name of the pipeline whose render pass is open, if one is.
     pub(super) render_pass_open: Option<String>,
+    /// What the commands since the last barrier read and wrote.
+    pub(super) hazards: Hazards,
 }
 
 impl Context {
@@ -81,6 +84,7 @@ impl Context {
             passes: Vec::new(),
             keep_alive: Vec::new(),
             render_pass_open: None,
+            hazards: Hazards::default(),
         };
         let result = recorder.record_and_run(record);
         let timings = result.and_then(|()| recorder.read_timings());
@@ -123,6 +127,10 @@ impl<'a> Recorder<'a> {
         }
         if self.open_pass.is_some() {
             self.end_pass();
+        }
+        if self.hazards.pending() {
+            // The host reads results once the fence signals: make the last writes visible to it.
+            self.memory_barrier(vk::PipelineStageFlags::HOST);
         }
         // SAFETY: recording is complete.
         unsafe { device.end_command_buffer(self.cmd) }.vk("vkEndCommandBuffer")?;
@@ -233,26 +241,52 @@ impl<'a> Recorder<'a> {
         self.passes.push((name, first));
     }
 
+    /// Orders the next command after everything recorded so far, when it touches what those
+    /// commands wrote or writes what they read (see `access.rs`). Every command calls this with
+    /// its own reads and writes before it is recorded.
+    pub(super) fn sync(&mut self, reads: &[Resource], writes: &[Resource]) {
+        if self.hazards.conflicts(reads, writes) {
+            self.barrier();
+        }
+        self.hazards.add(reads, writes);
+    }
+
+    /// Barriers placed and commands recorded so far in this submission.
+    pub fn barrier_counts(&self) -> (u32, u32) {
+        (self.hazards.barriers, self.hazards.commands)
+    }
+
     /// Makes all earlier shader and transfer writes visible to all later shader and transfer
-    /// reads and writes. Passes are separated by this; finer barriers buy little here.
-    pub fn barrier(&mut self) {
+    /// reads and writes: the one barrier `sync` places (a global memory barrier; the
+    /// dependency, not the access mask, is what costs).
+    pub(super) fn barrier(&mut self) {
+        self.memory_barrier(vk::PipelineStageFlags::ALL_COMMANDS);
+    }
+
+    fn memory_barrier(&mut self, dst_stage: vk::PipelineStageFlags) {
+        self.hazards.clear();
+        self.hazards.barriers += 1;
         let all = vk::AccessFlags::SHADER_READ
             | vk::AccessFlags::SHADER_WRITE
             | vk::AccessFlags::TRANSFER_READ
             | vk::AccessFlags::TRANSFER_WRITE
             | vk::AccessFlags::INDIRECT_COMMAND_READ
-            | vk::AccessFlags::HOST_READ
             | vk::AccessFlags::COLOR_ATTACHMENT_WRITE
             | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+        let dst = if dst_stage == vk::PipelineStageFlags::HOST {
+            vk::AccessFlags::HOST_READ
+        } else {
+            all
+        };
         let barrier = [vk::MemoryBarrier::default()
             .src_access_mask(all)
-            .dst_access_mask(all)];
+            .dst_access_mask(dst)];
         // SAFETY: recording; a global memory barrier has no resource references.
         unsafe {
             self.device().cmd_pipeline_barrier(
                 self.cmd,
                 vk::PipelineStageFlags::ALL_COMMANDS,
-                vk::PipelineStageFlags::ALL_COMMANDS,
+                dst_stage,
                 vk::DependencyFlags::empty(),
                 &barrier,
                 &[],
@@ -305,6 +339,10 @@ impl<'a> Recorder<'a> {
             src.name(),
             dst.name()
         );
+        self.sync(
+            &[Resource::buffer_range(src, src_offset, size_bytes)],
+            &[Resource::buffer_range(dst, dst_offset, size_bytes)],
+        );
         let region = [vk::BufferCopy {
             src_offset,
             dst_offset,
@@ -315,17 +353,16 @@ impl<'a> Recorder<'a> {
             self.device()
                 .cmd_copy_buffer(self.cmd, src.raw(), dst.raw(), &region)
         };
-        self.barrier();
     }
 
     /// Fills the whole buffer with a repeated 32-bit value.
     pub fn fill_buffer(&mut self, buffer: &Buffer, value: u32) {
+        self.sync(&[], &[Resource::buffer(buffer)]);
         // SAFETY: recording; WHOLE_SIZE covers the buffer, whose size is a multiple of 4.
         unsafe {
             self.device()
                 .cmd_fill_buffer(self.cmd, buffer.raw(), 0, vk::WHOLE_SIZE, value)
         };
-        self.barrier();
     }
 
     /// Uploads `data` into `dst` within this submission (the staging buffer lives until the
@@ -361,6 +398,7 @@ impl<'a> Recorder<'a> {
     }
 
     pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
+        self.sync(&[Resource::buffer(src)], &[Resource::image(dst)]);
         let region = [vk::BufferImageCopy::default()
             .image_subresource(dst.subresource_layers())
             .image_extent(dst.vk_extent())];
@@ -374,11 +412,11 @@ impl<'a> Recorder<'a> {
                 &region,
             )
         };
-        self.barrier();
     }
 
     /// Copies the whole image into `dst`, tightly packed (row-major x, then y, then z).
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
+        self.sync(&[Resource::image(src)], &[Resource::buffer(dst)]);
         let region = [vk::BufferImageCopy::default()
             .image_subresource(src.subresource_layers())
             .image_extent(src.vk_extent())];
@@ -392,11 +430,11 @@ impl<'a> Recorder<'a> {
                 &region,
             )
         };
-        self.barrier();
     }
 
     /// Clears a colour image to `rgba`.
     pub fn clear_image(&mut self, image: &Image, rgba: [f32; 4]) {
+        self.sync(&[], &[Resource::image(image)]);
         let color = vk::ClearColorValue { float32: rgba };
         // SAFETY: recording; the image is in GENERAL layout.
         unsafe {
@@ -408,7 +446,6 @@ impl<'a> Recorder<'a> {
                 &[image.subresource_range()],
             )
         };
-        self.barrier();
     }
 
     fn allocate_set(
@@ -439,7 +476,7 @@ impl<'a> Recorder<'a> {
     }
 
     /// Binds `bindings` (in the pipeline's declared order) and `push_constants`, and
-    /// dispatches `groups` workgroups. A barrier follows, so the next pass sees the results.
+    /// dispatches `groups` workgroups, after a barrier if it depends on earlier commands.
     pub fn dispatch<P: bytemuck::Pod>(
         &mut self,
         pipeline: &ComputePipeline,
@@ -470,12 +507,13 @@ impl<'a> Recorder<'a> {
         if groups.contains(&0) {
             return Ok(());
         }
+        let (reads, writes) = binding_access(bindings, &pipeline.layout.access);
+        self.sync(&reads, &writes);
         // SAFETY: recording; pipeline, set and push constants were bound by bind().
         unsafe {
             self.device()
                 .cmd_dispatch(self.cmd, groups[0], groups[1], groups[2])
         };
-        self.barrier();
         Ok(())
     }
 
@@ -493,12 +531,14 @@ impl<'a> Recorder<'a> {
             bindings,
             bytemuck::bytes_of(push_constants),
         )?;
+        let (mut reads, writes) = binding_access(bindings, &pipeline.layout.access);
+        reads.push(Resource::buffer_range(args, offset, 12));
+        self.sync(&reads, &writes);
         // SAFETY: recording; the args buffer has INDIRECT usage and holds 12 bytes at offset.
         unsafe {
             self.device()
                 .cmd_dispatch_indirect(self.cmd, args.raw(), offset)
         };
-        self.barrier();
         Ok(())
     }
 
@@ -512,37 +552,38 @@ impl<'a> Recorder<'a> {
             pass: pipeline.name.to_string(),
             message,
         };
-        if bindings.len() != pipeline.kinds.len() {
+        if bindings.len() != pipeline.layout.kinds.len() {
             return Err(usage(format!(
                 "{} bindings given, the pipeline declares {}",
                 bindings.len(),
-                pipeline.kinds.len()
+                pipeline.layout.kinds.len()
             )));
         }
-        if push.len() as u32 != pipeline.push_constant_bytes {
+        if push.len() as u32 != pipeline.layout.push_constant_bytes {
             return Err(usage(format!(
                 "{} bytes of push constants given, the pipeline declares {}",
                 push.len(),
-                pipeline.push_constant_bytes
+                pipeline.layout.push_constant_bytes
             )));
         }
-        for (i, (binding, kind)) in bindings.iter().zip(pipeline.kinds).enumerate() {
+        for (i, (binding, kind)) in bindings.iter().zip(&pipeline.layout.kinds).enumerate() {
             if !binding.matches(*kind) {
                 return Err(usage(format!("binding {i} must be a {kind:?}")));
             }
         }
         let max_range = u64::from(self.ctx.limits().max_storage_buffer_range);
-        let set = if pipeline.kinds.is_empty() {
+        let set = if pipeline.layout.kinds.is_empty() {
             None
         } else {
-            Some(self.allocate_set(pipeline.set_layout)?)
+            Some(self.allocate_set(pipeline.layout.set_layout)?)
         };
         let mut buffer_infos = Vec::with_capacity(bindings.len());
         let mut image_infos = Vec::with_capacity(bindings.len());
         for (i, binding) in bindings.iter().enumerate() {
             match *binding {
                 Binding::Buffer(b) => {
-                    if pipeline.kinds[i] == BindingKind::StorageBuffer && b.size_bytes() > max_range
+                    if pipeline.layout.kinds[i] == BindingKind::StorageBuffer
+                        && b.size_bytes() > max_range
                     {
                         return Err(usage(format!(
                             "buffer \"{}\" of {} MiB exceeds this device's {} MiB storage-buffer binding limit; bind it in ranges",
@@ -597,7 +638,7 @@ impl<'a> Recorder<'a> {
                 vk::WriteDescriptorSet::default()
                     .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
-                    .descriptor_type(pipeline.kinds[*i].descriptor_type())
+                    .descriptor_type(pipeline.layout.kinds[*i].descriptor_type())
                     .buffer_info(std::slice::from_ref(info)),
             );
         }
@@ -606,7 +647,7 @@ impl<'a> Recorder<'a> {
                 vk::WriteDescriptorSet::default()
                     .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
-                    .descriptor_type(pipeline.kinds[*i].descriptor_type())
+                    .descriptor_type(pipeline.layout.kinds[*i].descriptor_type())
                     .image_info(std::slice::from_ref(info)),
             );
         }
@@ -620,22 +661,22 @@ impl<'a> Recorder<'a> {
                 device.cmd_bind_descriptor_sets(
                     self.cmd,
                     pipeline.bind_point,
-                    pipeline.layout,
+                    pipeline.layout.layout,
                     0,
                     &[set],
                     &[],
                 );
             }
             if !push.is_empty() {
-                device.cmd_push_constants(self.cmd, pipeline.layout, pipeline.stages, 0, push);
+                device.cmd_push_constants(
+                    self.cmd,
+                    pipeline.layout.layout,
+                    pipeline.layout.stages,
+                    0,
+                    push,
+                );
             }
         }
         Ok(())
-    }
-
-    /// The raw command buffer, for passes (such as the rasteriser) that record graphics work
-    /// this layer does not wrap.
-    pub fn raw_command_buffer(&self) -> vk::CommandBuffer {
-        self.cmd
     }
 }

@@ -321,8 +321,12 @@ fn create_instance(
         .application_info(&app)
         .enabled_layer_names(&layers)
         .enabled_extension_names(&extensions);
+    // Synchronization validation checks the barriers the recorder derives from declared
+    // access (src/gpu/access.rs): a missing dependency is a validation error in every test.
+    let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
     if validate {
-        info = info.push_next(&mut messenger);
+        info = info.push_next(&mut messenger).push_next(&mut features);
     }
     // SAFETY: all pointers in `info` outlive the call.
     unsafe { entry.create_instance(&info, None) }.map_err(|result| match result {

@@ -13,7 +13,7 @@ use ash::vk;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::{Image, TexelFormat};
-use super::pipeline::{BindingKind, PipelineParts};
+use super::pipeline::{BindingKind, Layout, PipelineParts};
 
 /// The type of one vertex attribute (32-bit floats).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,15 +81,13 @@ struct ColorTarget {
 pub struct GraphicsPipeline {
     shared: Arc<DeviceShared>,
     name: String,
-    kinds: Vec<BindingKind>,
-    push_constant_bytes: u32,
     colors: Vec<ColorTarget>,
     depth: Option<TexelFormat>,
     samples: u32,
-    set_layout: vk::DescriptorSetLayout,
-    layout: vk::PipelineLayout,
     render_pass: vk::RenderPass,
     pipeline: vk::Pipeline,
+    // Declared last: dropped after the pipeline that uses it.
+    layout: Layout,
 }
 
 pub struct GraphicsPipelineBuilder<'a> {
@@ -156,13 +154,9 @@ impl GraphicsPipeline {
     pub(crate) fn parts(&self) -> PipelineParts<'_> {
         PipelineParts {
             name: &self.name,
-            kinds: &self.kinds,
-            push_constant_bytes: self.push_constant_bytes,
-            set_layout: self.set_layout,
-            layout: self.layout,
+            layout: &self.layout,
             pipeline: self.pipeline,
             bind_point: vk::PipelineBindPoint::GRAPHICS,
-            stages: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
         }
     }
 
@@ -337,13 +331,6 @@ impl<'a> GraphicsPipelineBuilder<'a> {
             pass: self.name.to_string(),
             message,
         };
-        let max_push = shared.properties.limits.max_push_constants_size;
-        if self.push_constant_bytes > max_push {
-            return Err(GpuError::Unsupported(format!(
-                "{} bytes of push constants in pass \"{}\" (limit {max_push})",
-                self.push_constant_bytes, self.name
-            )));
-        }
         let samples = vk::SampleCountFlags::from_raw(self.samples);
         let limits = &shared.properties.limits;
         let supported =
@@ -366,32 +353,24 @@ impl<'a> GraphicsPipelineBuilder<'a> {
         let vertex_words = read(self.vertex_spirv)?;
         let fragment_words = read(self.fragment_spirv)?;
 
+        let layout = Layout::new(
+            &shared,
+            self.name,
+            &self.kinds,
+            self.push_constant_bytes,
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            &[self.vertex_spirv, self.fragment_spirv],
+        )?;
         let mut pipeline = GraphicsPipeline {
             shared: shared.clone(),
             name: self.name.to_string(),
-            kinds: self.kinds.clone(),
-            push_constant_bytes: self.push_constant_bytes,
             colors: self.colors.clone(),
             depth: self.depth.map(|(f, _)| f),
             samples: self.samples,
-            set_layout: vk::DescriptorSetLayout::null(),
-            layout: vk::PipelineLayout::null(),
             render_pass: vk::RenderPass::null(),
             pipeline: vk::Pipeline::null(),
+            layout,
         };
-        let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let layout_bindings: Vec<_> = self
-            .kinds
-            .iter()
-            .enumerate()
-            .map(|(i, kind)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(kind.descriptor_type())
-                    .descriptor_count(1)
-                    .stage_flags(stages_flags)
-            })
-            .collect();
 
         // Attachments: colours, their resolves, depth; all kept in GENERAL like every image.
         let general = vk::ImageLayout::GENERAL;
@@ -514,22 +493,6 @@ impl<'a> GraphicsPipelineBuilder<'a> {
             pipeline.render_pass = device
                 .create_render_pass(&pass_info, None)
                 .vk("vkCreateRenderPass")?;
-            let set_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
-            pipeline.set_layout = device
-                .create_descriptor_set_layout(&set_info, None)
-                .vk("vkCreateDescriptorSetLayout")?;
-            let ranges = [vk::PushConstantRange::default()
-                .stage_flags(stages_flags)
-                .offset(0)
-                .size(self.push_constant_bytes)];
-            let set_layouts = [pipeline.set_layout];
-            let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-            if self.push_constant_bytes > 0 {
-                layout_info = layout_info.push_constant_ranges(&ranges);
-            }
-            pipeline.layout = device
-                .create_pipeline_layout(&layout_info, None)
-                .vk("vkCreatePipelineLayout")?;
 
             let vertex_module = device
                 .create_shader_module(
@@ -626,7 +589,7 @@ impl<'a> GraphicsPipelineBuilder<'a> {
                 .depth_stencil_state(&depth_stencil)
                 .color_blend_state(&blend)
                 .dynamic_state(&dynamic)
-                .layout(pipeline.layout)
+                .layout(pipeline.layout.layout)
                 .render_pass(pipeline.render_pass)
                 .subpass(0)];
             let created = device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None);
@@ -647,8 +610,6 @@ impl Drop for GraphicsPipeline {
         unsafe {
             let device = &self.shared.device;
             device.destroy_pipeline(self.pipeline, None);
-            device.destroy_pipeline_layout(self.layout, None);
-            device.destroy_descriptor_set_layout(self.set_layout, None);
             device.destroy_render_pass(self.render_pass, None);
         }
     }

@@ -2,6 +2,7 @@
 //! `render` build on it. Every resource holds the device alive; every submission waits for
 //! completion, so resources can be dropped in any order.
 
+mod access;
 mod buffer;
 mod commands;
 mod context;
@@ -9,6 +10,7 @@ mod error;
 mod graphics;
 mod image;
 mod pipeline;
+mod reflect;
 mod render_pass;
 mod submit_slot;
 pub mod texture_probe;
@@ -26,5 +28,6 @@ pub use graphics::{
 };
 pub use image::{Edge, Image, ImageUsage, Sampler, TexelFormat};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, ComputePipelineBuilder};
+pub use reflect::{reflect, Access, ReflectedBinding, Reflection};
 
 pub use ash::vk;

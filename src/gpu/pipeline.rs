@@ -10,6 +10,7 @@ use super::buffer::Buffer;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::{Image, Sampler};
+use super::reflect::{reflect, Access};
 
 /// The kind of resource a shader binding expects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,23 +61,155 @@ impl Binding<'_> {
 /// What the recorder needs to bind any pipeline, compute or graphics, with its resources.
 pub(crate) struct PipelineParts<'p> {
     pub(crate) name: &'p str,
-    pub(crate) kinds: &'p [BindingKind],
-    pub(crate) push_constant_bytes: u32,
-    pub(crate) set_layout: vk::DescriptorSetLayout,
-    pub(crate) layout: vk::PipelineLayout,
+    pub(crate) layout: &'p Layout,
     pub(crate) pipeline: vk::Pipeline,
     pub(crate) bind_point: vk::PipelineBindPoint,
+}
+
+/// The descriptor-set and pipeline layouts of a pass, built by one code path for compute and
+/// graphics pipelines from the bindings and push-constant struct the pass declares, after
+/// checking both against what its shaders declare (SPIR-V reflection): a binding list that
+/// disagrees with its shader is an error when the pipeline is built, not a validation
+/// message (or undefined behaviour) when it runs. The shaders' access (readonly / writeonly)
+/// is kept for the recorder to derive barriers from.
+pub(crate) struct Layout {
+    shared: Arc<DeviceShared>,
+    pub(crate) kinds: Vec<BindingKind>,
+    pub(crate) access: Vec<Access>,
+    pub(crate) push_constant_bytes: u32,
     pub(crate) stages: vk::ShaderStageFlags,
+    pub(crate) set_layout: vk::DescriptorSetLayout,
+    pub(crate) layout: vk::PipelineLayout,
+}
+
+impl Layout {
+    pub(crate) fn new(
+        shared: &Arc<DeviceShared>,
+        name: &str,
+        kinds: &[BindingKind],
+        push_constant_bytes: u32,
+        stages: vk::ShaderStageFlags,
+        modules: &[&[u8]],
+    ) -> GpuResult<Layout> {
+        let usage = |message: String| GpuError::Usage {
+            pass: name.to_string(),
+            message,
+        };
+        let max_push = shared.properties.limits.max_push_constants_size;
+        if push_constant_bytes > max_push {
+            return Err(GpuError::Unsupported(format!(
+                "{push_constant_bytes} bytes of push constants in pass \"{name}\" (limit {max_push})"
+            )));
+        }
+        let access = check_against_shaders(kinds, push_constant_bytes, modules).map_err(usage)?;
+        let mut out = Layout {
+            shared: shared.clone(),
+            kinds: kinds.to_vec(),
+            access,
+            push_constant_bytes,
+            stages,
+            set_layout: vk::DescriptorSetLayout::null(),
+            layout: vk::PipelineLayout::null(),
+        };
+        let layout_bindings: Vec<_> = kinds
+            .iter()
+            .enumerate()
+            .map(|(i, kind)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(kind.descriptor_type())
+                    .descriptor_count(1)
+                    .stage_flags(stages)
+            })
+            .collect();
+        let device = &shared.device;
+        // SAFETY: create infos reference locals that outlive each call; on early return the
+        // partially built layout's Drop destroys what was created.
+        unsafe {
+            let set_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
+            out.set_layout = device
+                .create_descriptor_set_layout(&set_info, None)
+                .vk("vkCreateDescriptorSetLayout")?;
+            let ranges = [vk::PushConstantRange::default()
+                .stage_flags(stages)
+                .offset(0)
+                .size(push_constant_bytes)];
+            let set_layouts = [out.set_layout];
+            let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+            if push_constant_bytes > 0 {
+                layout_info = layout_info.push_constant_ranges(&ranges);
+            }
+            out.layout = device
+                .create_pipeline_layout(&layout_info, None)
+                .vk("vkCreatePipelineLayout")?;
+        }
+        Ok(out)
+    }
+}
+
+impl Drop for Layout {
+    fn drop(&mut self) {
+        // SAFETY: submissions complete before returning, and the pipeline using this layout
+        // is destroyed first (it is dropped before its layout field); null handles are ignored.
+        unsafe {
+            let device = &self.shared.device;
+            device.destroy_pipeline_layout(self.layout, None);
+            device.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// The declared bindings (0, 1, … of set 0) and push-constant size against the union of what
+/// `modules` declare; returns each binding's access over all stages.
+fn check_against_shaders(
+    kinds: &[BindingKind],
+    push_constant_bytes: u32,
+    modules: &[&[u8]],
+) -> Result<Vec<Access>, String> {
+    let mut found: Vec<Option<(BindingKind, Access)>> = vec![None; kinds.len()];
+    let mut push = 0;
+    for spirv in modules {
+        let r = reflect(spirv)?;
+        push = push.max(r.push_constant_bytes);
+        for b in r.bindings {
+            let Some(slot) = found.get_mut(b.binding as usize) else {
+                return Err(format!(
+                    "the shader uses binding {} but the pass declares {} bindings",
+                    b.binding,
+                    kinds.len()
+                ));
+            };
+            if b.kind != kinds[b.binding as usize] {
+                return Err(format!(
+                    "binding {} is a {:?} in the shader, declared as {:?}",
+                    b.binding, b.kind, kinds[b.binding as usize]
+                ));
+            }
+            *slot = Some(match *slot {
+                Some((k, a)) if a != b.access => (k, Access::ReadWrite),
+                _ => (b.kind, b.access),
+            });
+        }
+    }
+    if push != push_constant_bytes {
+        return Err(format!(
+            "the shader's push-constant block is {push} bytes, the pass's struct {push_constant_bytes}"
+        ));
+    }
+    found
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            f.map(|(_, a)| a)
+                .ok_or(format!("binding {i} is declared but the shader has none"))
+        })
+        .collect()
 }
 
 pub struct ComputePipeline {
-    shared: Arc<DeviceShared>,
     pub(crate) name: String,
-    pub(crate) kinds: Vec<BindingKind>,
-    pub(crate) push_constant_bytes: u32,
-    pub(crate) set_layout: vk::DescriptorSetLayout,
-    pub(crate) layout: vk::PipelineLayout,
     pub(crate) pipeline: vk::Pipeline,
+    pub(crate) layout: Layout,
 }
 
 pub struct ComputePipelineBuilder<'a> {
@@ -103,16 +236,17 @@ impl ComputePipeline {
         &self.name
     }
 
+    /// Bytes of the pass's push-constant block.
+    pub fn push_constant_bytes(&self) -> u32 {
+        self.layout.push_constant_bytes
+    }
+
     pub(crate) fn parts(&self) -> PipelineParts<'_> {
         PipelineParts {
             name: &self.name,
-            kinds: &self.kinds,
-            push_constant_bytes: self.push_constant_bytes,
-            set_layout: self.set_layout,
-            layout: self.layout,
+            layout: &self.layout,
             pipeline: self.pipeline,
             bind_point: vk::PipelineBindPoint::COMPUTE,
-            stages: vk::ShaderStageFlags::COMPUTE,
         }
     }
 }
@@ -140,59 +274,28 @@ impl<'a> ComputePipelineBuilder<'a> {
     pub fn build(self, ctx: &Context) -> GpuResult<ComputePipeline> {
         let shared = ctx.shared.clone();
         let device = &shared.device;
-        let max_push = shared.properties.limits.max_push_constants_size;
-        if self.push_constant_bytes > max_push {
-            return Err(GpuError::Unsupported(format!(
-                "{} bytes of push constants in pass \"{}\" (limit {max_push})",
-                self.push_constant_bytes, self.name
-            )));
-        }
         let words = ash::util::read_spv(&mut std::io::Cursor::new(self.spirv)).map_err(|e| {
             GpuError::Usage {
                 pass: self.name.to_string(),
                 message: format!("invalid SPIR-V: {e}"),
             }
         })?;
-        let layout_bindings: Vec<_> = self
-            .kinds
-            .iter()
-            .enumerate()
-            .map(|(i, kind)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(kind.descriptor_type())
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
+        let layout = Layout::new(
+            &shared,
+            self.name,
+            &self.kinds,
+            self.push_constant_bytes,
+            vk::ShaderStageFlags::COMPUTE,
+            &[self.spirv],
+        )?;
         let mut pipeline = ComputePipeline {
-            shared: shared.clone(),
             name: self.name.to_string(),
-            kinds: self.kinds.clone(),
-            push_constant_bytes: self.push_constant_bytes,
-            set_layout: vk::DescriptorSetLayout::null(),
-            layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            layout,
         };
         // SAFETY: create infos reference locals that outlive each call; on early return the
         // partially built pipeline's Drop destroys what was created.
         unsafe {
-            let set_info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings);
-            pipeline.set_layout = device
-                .create_descriptor_set_layout(&set_info, None)
-                .vk("vkCreateDescriptorSetLayout")?;
-            let ranges = [vk::PushConstantRange::default()
-                .stage_flags(vk::ShaderStageFlags::COMPUTE)
-                .offset(0)
-                .size(self.push_constant_bytes)];
-            let set_layouts = [pipeline.set_layout];
-            let mut layout_info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-            if self.push_constant_bytes > 0 {
-                layout_info = layout_info.push_constant_ranges(&ranges);
-            }
-            pipeline.layout = device
-                .create_pipeline_layout(&layout_info, None)
-                .vk("vkCreatePipelineLayout")?;
             let module_info = vk::ShaderModuleCreateInfo::default().code(&words);
             let module = device
                 .create_shader_module(&module_info, None)
@@ -222,7 +325,7 @@ impl<'a> ComputePipelineBuilder<'a> {
                 .specialization_info(&spec);
             let info = [vk::ComputePipelineCreateInfo::default()
                 .stage(stage)
-                .layout(pipeline.layout)];
+                .layout(pipeline.layout.layout)];
             let created = device.create_compute_pipelines(vk::PipelineCache::null(), &info, None);
             device.destroy_shader_module(module, None);
             pipeline.pipeline = created.map_err(|(_, e)| e).vk("vkCreateComputePipelines")?[0];
@@ -233,12 +336,13 @@ impl<'a> ComputePipelineBuilder<'a> {
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
-        // SAFETY: submissions complete before returning; null handles are ignored by Vulkan.
+        // SAFETY: submissions complete before returning; a null handle is ignored. The layout
+        // field is dropped after this, so the pipeline goes before its layout.
         unsafe {
-            let device = &self.shared.device;
-            device.destroy_pipeline(self.pipeline, None);
-            device.destroy_pipeline_layout(self.layout, None);
-            device.destroy_descriptor_set_layout(self.set_layout, None);
+            self.layout
+                .shared
+                .device
+                .destroy_pipeline(self.pipeline, None);
         }
     }
 }

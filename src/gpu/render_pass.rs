@@ -29,6 +29,11 @@ impl Recorder<'_> {
         if let Some(open) = &self.render_pass_open {
             return Err(usage(format!("render pass of \"{open}\" is still open")));
         }
+        // A render pass is a full synchronisation point: its attachments and bindings are not
+        // tracked one by one.
+        if self.hazards.pending() {
+            self.barrier();
+        }
         if clear_colors.len() != parts.color_count {
             return Err(usage(format!(
                 "{} clear colours given, the pipeline has {} colour targets",

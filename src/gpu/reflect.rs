@@ -1,0 +1,344 @@
+//! What a SPIR-V module declares, read from its words: the set-0 bindings (kind and whether
+//! the shader reads, writes or both) and the size of its push-constant block. Pipelines check
+//! the bindings and push-constant struct a pass declares in Rust against it when they are
+//! built, and the recorder derives barriers from the access (src/gpu/access.rs), so a binding
+//! list can no longer disagree with its shader unnoticed.
+
+use super::pipeline::BindingKind;
+
+/// How a shader uses a binding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    Read,
+    Write,
+    ReadWrite,
+}
+
+impl Access {
+    pub fn reads(self) -> bool {
+        self != Access::Write
+    }
+
+    pub fn writes(self) -> bool {
+        self != Access::Read
+    }
+}
+
+/// One binding of descriptor set 0.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ReflectedBinding {
+    pub binding: u32,
+    pub kind: BindingKind,
+    pub access: Access,
+}
+
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Reflection {
+    /// Set-0 bindings in binding order.
+    pub bindings: Vec<ReflectedBinding>,
+    /// Bytes of the push-constant block (0 without one).
+    pub push_constant_bytes: u32,
+}
+
+mod op {
+    pub const DECORATE: u32 = 71;
+    pub const MEMBER_DECORATE: u32 = 72;
+    pub const TYPE_INT: u32 = 21;
+    pub const TYPE_FLOAT: u32 = 22;
+    pub const TYPE_VECTOR: u32 = 23;
+    pub const TYPE_MATRIX: u32 = 24;
+    pub const TYPE_IMAGE: u32 = 25;
+    pub const TYPE_SAMPLED_IMAGE: u32 = 27;
+    pub const TYPE_ARRAY: u32 = 28;
+    pub const TYPE_RUNTIME_ARRAY: u32 = 29;
+    pub const TYPE_STRUCT: u32 = 30;
+    pub const TYPE_POINTER: u32 = 32;
+    pub const CONSTANT: u32 = 43;
+    pub const VARIABLE: u32 = 59;
+}
+
+mod deco {
+    pub const BUFFER_BLOCK: u32 = 3;
+    pub const ARRAY_STRIDE: u32 = 6;
+    pub const MATRIX_STRIDE: u32 = 7;
+    pub const NON_WRITABLE: u32 = 24;
+    pub const NON_READABLE: u32 = 25;
+    pub const BINDING: u32 = 33;
+    pub const DESCRIPTOR_SET: u32 = 34;
+    pub const OFFSET: u32 = 35;
+}
+
+mod class {
+    pub const UNIFORM_CONSTANT: u32 = 0;
+    pub const UNIFORM: u32 = 2;
+    pub const PUSH_CONSTANT: u32 = 9;
+    pub const STORAGE_BUFFER: u32 = 12;
+}
+
+#[derive(Clone, Debug)]
+enum Type {
+    Scalar(u32),
+    Vector(u32, u32),
+    Matrix(u32, u32),
+    Image { sampled: u32 },
+    SampledImage,
+    Array(u32, u32),
+    RuntimeArray,
+    Struct(Vec<u32>),
+    Pointer(u32),
+    Other,
+}
+
+#[derive(Default)]
+struct Module {
+    types: std::collections::HashMap<u32, Type>,
+    constants: std::collections::HashMap<u32, u32>,
+    /// (id, decoration) → first literal (or 0).
+    decorations: std::collections::HashMap<(u32, u32), u32>,
+    /// (struct, member, decoration) → first literal (or 0).
+    member_decorations: std::collections::HashMap<(u32, u32, u32), u32>,
+    /// (variable, pointer type, storage class)
+    variables: Vec<(u32, u32, u32)>,
+}
+
+/// Reads `spirv` (bytes of a SPIR-V module). Errors name what is malformed.
+pub fn reflect(spirv: &[u8]) -> Result<Reflection, String> {
+    if spirv.len() % 4 != 0 || spirv.len() < 20 {
+        return Err("not a SPIR-V module (length)".into());
+    }
+    let words: Vec<u32> = spirv
+        .chunks_exact(4)
+        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    if words[0] != 0x0723_0203 {
+        return Err("not a SPIR-V module (magic number)".into());
+    }
+    let module = parse(&words[5..])?;
+    module.reflection()
+}
+
+fn parse(mut words: &[u32]) -> Result<Module, String> {
+    let mut m = Module::default();
+    while !words.is_empty() {
+        let count = (words[0] >> 16) as usize;
+        let opcode = words[0] & 0xffff;
+        if count == 0 || count > words.len() {
+            return Err("truncated SPIR-V instruction".into());
+        }
+        let a = &words[1..count];
+        let at = |i: usize| a.get(i).copied().unwrap_or(0);
+        match opcode {
+            op::DECORATE => {
+                m.decorations.insert((at(0), at(1)), at(2));
+            }
+            op::MEMBER_DECORATE => {
+                m.member_decorations.insert((at(0), at(1), at(2)), at(3));
+            }
+            op::TYPE_INT | op::TYPE_FLOAT => {
+                m.types.insert(at(0), Type::Scalar(at(1) / 8));
+            }
+            op::TYPE_VECTOR => {
+                m.types.insert(at(0), Type::Vector(at(1), at(2)));
+            }
+            op::TYPE_MATRIX => {
+                m.types.insert(at(0), Type::Matrix(at(1), at(2)));
+            }
+            op::TYPE_IMAGE => {
+                m.types.insert(at(0), Type::Image { sampled: at(6) });
+            }
+            op::TYPE_SAMPLED_IMAGE => {
+                m.types.insert(at(0), Type::SampledImage);
+            }
+            op::TYPE_ARRAY => {
+                m.types.insert(at(0), Type::Array(at(1), at(2)));
+            }
+            op::TYPE_RUNTIME_ARRAY => {
+                m.types.insert(at(0), Type::RuntimeArray);
+            }
+            op::TYPE_STRUCT => {
+                m.types.insert(at(0), Type::Struct(a[1..].to_vec()));
+            }
+            op::TYPE_POINTER => {
+                m.types.insert(at(0), Type::Pointer(at(2)));
+            }
+            op::CONSTANT => {
+                m.constants.insert(at(1), at(2));
+            }
+            op::VARIABLE => m.variables.push((at(1), at(0), at(2))),
+            _ => {
+                if (20..=39).contains(&opcode) && !a.is_empty() {
+                    m.types.entry(at(0)).or_insert(Type::Other);
+                }
+            }
+        }
+        words = &words[count..];
+    }
+    Ok(m)
+}
+
+impl Module {
+    fn pointee(&self, pointer: u32) -> Option<u32> {
+        match self.types.get(&pointer) {
+            Some(Type::Pointer(t)) => Some(*t),
+            _ => None,
+        }
+    }
+
+    fn has(&self, id: u32, decoration: u32) -> bool {
+        self.decorations.contains_key(&(id, decoration))
+    }
+
+    /// Size in bytes of a type as laid out in an explicitly laid-out block.
+    fn size_of(&self, id: u32) -> Result<u32, String> {
+        Ok(match self.types.get(&id) {
+            Some(Type::Scalar(bytes)) => *bytes,
+            Some(Type::Vector(component, n)) => self.size_of(*component)? * n,
+            Some(Type::Matrix(column, n)) => {
+                let stride = self.size_of(*column)?;
+                stride * n
+            }
+            Some(Type::Array(element, length)) => {
+                let n = *self
+                    .constants
+                    .get(length)
+                    .ok_or("array length is not a plain constant")?;
+                let stride = match self.decorations.get(&(id, deco::ARRAY_STRIDE)) {
+                    Some(&s) => s,
+                    None => self.size_of(*element)?,
+                };
+                stride * n
+            }
+            Some(Type::Struct(members)) => {
+                let mut end = 0;
+                for (i, &member) in members.iter().enumerate() {
+                    let offset = self
+                        .member_decorations
+                        .get(&(id, i as u32, deco::OFFSET))
+                        .copied()
+                        .ok_or("struct member without an offset")?;
+                    let _ = self
+                        .member_decorations
+                        .get(&(id, i as u32, deco::MATRIX_STRIDE));
+                    end = end.max(offset + self.size_of(member)?);
+                }
+                end
+            }
+            _ => return Err(format!("type %{id} has no size in a block")),
+        })
+    }
+
+    /// Access of a buffer block: read-only when every member is NonWritable, write-only when
+    /// every member is NonReadable (glslang's `readonly` / `writeonly` on a block).
+    fn block_access(&self, variable: u32, block: u32) -> Access {
+        let members = match self.types.get(&block) {
+            Some(Type::Struct(m)) => m.len() as u32,
+            _ => 0,
+        };
+        let all = |d: u32| {
+            self.has(variable, d)
+                || (members > 0
+                    && (0..members).all(|i| self.member_decorations.contains_key(&(block, i, d))))
+        };
+        access_of(all(deco::NON_WRITABLE), all(deco::NON_READABLE))
+    }
+
+    fn reflection(&self) -> Result<Reflection, String> {
+        let mut out = Reflection::default();
+        for &(var, pointer, storage) in &self.variables {
+            let Some(pointee) = self.pointee(pointer) else {
+                continue;
+            };
+            if storage == class::PUSH_CONSTANT {
+                out.push_constant_bytes = self.size_of(pointee)?;
+                continue;
+            }
+            let Some(&binding) = self.decorations.get(&(var, deco::BINDING)) else {
+                continue;
+            };
+            if self.decorations.get(&(var, deco::DESCRIPTOR_SET)).copied() != Some(0) {
+                continue;
+            }
+            let (kind, access) = match (storage, self.types.get(&pointee)) {
+                (class::STORAGE_BUFFER, _) => {
+                    (BindingKind::StorageBuffer, self.block_access(var, pointee))
+                }
+                (class::UNIFORM, _) if self.has(pointee, deco::BUFFER_BLOCK) => {
+                    (BindingKind::StorageBuffer, self.block_access(var, pointee))
+                }
+                (class::UNIFORM, _) => (BindingKind::UniformBuffer, Access::Read),
+                (class::UNIFORM_CONSTANT, Some(Type::SampledImage)) => {
+                    (BindingKind::SampledImage, Access::Read)
+                }
+                (class::UNIFORM_CONSTANT, Some(Type::Image { sampled: 2 })) => (
+                    BindingKind::StorageImage,
+                    access_of(
+                        self.has(var, deco::NON_WRITABLE),
+                        self.has(var, deco::NON_READABLE),
+                    ),
+                ),
+                _ => {
+                    return Err(format!(
+                        "binding {binding}: a resource type ocular does not bind"
+                    ))
+                }
+            };
+            out.bindings.push(ReflectedBinding {
+                binding,
+                kind,
+                access,
+            });
+        }
+        out.bindings.sort_by_key(|b| b.binding);
+        Ok(out)
+    }
+}
+
+fn access_of(non_writable: bool, non_readable: bool) -> Access {
+    match (non_writable, non_readable) {
+        (true, _) => Access::Read,
+        (false, true) => Access::Write,
+        (false, false) => Access::ReadWrite,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Checked against the GLSL source of the convolution: a sampler, four read-only fragment
+    /// ranges (1, 6, 7, 8), three read-only list buffers and a write-only output image, under
+    /// the 128-byte frame parameters.
+    #[test]
+    fn convolve_shader_reflects_as_written() {
+        let r = reflect(crate::shaders::RENDER_SPLAT_CONVOLVE_COMP).unwrap();
+        assert_eq!(r.push_constant_bytes, 128);
+        let got: Vec<(u32, BindingKind, Access)> = r
+            .bindings
+            .iter()
+            .map(|b| (b.binding, b.kind, b.access))
+            .collect();
+        use Access::*;
+        use BindingKind::*;
+        assert_eq!(
+            got,
+            vec![
+                (0, SampledImage, Read),
+                (1, StorageBuffer, Read),
+                (2, StorageBuffer, Read),
+                (3, StorageBuffer, Read),
+                (4, StorageBuffer, Read),
+                (5, StorageImage, Write),
+                (6, StorageBuffer, Read),
+                (7, StorageBuffer, Read),
+                (8, StorageBuffer, Read),
+            ]
+        );
+        // Merge reads and writes its fragments; tile count reads them and updates counts.
+        let merge = reflect(crate::shaders::RENDER_SPLAT_MERGE_COMP).unwrap();
+        assert_eq!(merge.bindings[0].access, Read);
+        assert_eq!(merge.bindings[1].access, ReadWrite);
+        let fill = reflect(crate::shaders::RENDER_SPLAT_FRAGMENTS_COMP).unwrap();
+        assert_eq!(fill.bindings[3].access, Write);
+        assert!(reflect(&[0u8; 24]).is_err());
+    }
+}
