@@ -70,7 +70,7 @@ fn a_plane_through_the_four_eyes_is_its_convolution() {
         .collect();
     let options = KernelOptions {
         cache_dir: None,
-        progress: false,
+        progress: None,
         ..KernelOptions::default()
     };
     let state = EyeState {

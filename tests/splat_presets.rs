@@ -77,7 +77,7 @@ fn four_preset_eyes_match_the_ground_truth() {
     };
     let options = KernelOptions {
         cache_dir: None,
-        progress: false,
+        progress: None,
         ..KernelOptions::default()
     };
     for (name, bar_db) in BARS_DB {

@@ -13,7 +13,7 @@ use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
 use crate::render::frame::{FrameRenderer, Method};
-use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
+use crate::render::splat::FrameInput;
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -42,17 +42,8 @@ pub struct BenchArgs {
     /// Pupil diameter (default: the scene's, else 5 mm as in the seed paper's tests).
     #[arg(long, value_name = "MM")]
     pub pupil_mm: Option<f64>,
-    /// Screen tile size: 8, 16 or 32.
-    #[arg(long, default_value_t = 8)]
-    pub tile_size: u32,
-    /// Storage of the PSF texture the splatting samples.
-    #[arg(long, value_enum, default_value = "rgba16f")]
-    pub texture_format: PsfTextureFormat,
-    /// Fragment merging: 0 = off, 1 = 2×2, 2 = also 4×4.
-    #[arg(long, default_value_t = 1)]
-    pub merge_levels: u32,
     #[command(flatten)]
-    pub blend: super::BlendArgs,
+    pub splat: super::SplatArgs,
     /// Also time the ground truth and the slice method once each, and print speed ratios.
     #[arg(long)]
     pub compare_methods: bool,
@@ -228,15 +219,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         outputs.add("--json", path, &["json"])?;
     }
     outputs.probe()?;
-    let splat = super::splat_settings(
-        args.tile_size,
-        args.texture_format,
-        MergeSettings {
-            levels: args.merge_levels,
-            ..MergeSettings::default()
-        },
-        &args.blend,
-    )?;
+    let splat = args.splat.settings()?;
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;

@@ -14,7 +14,7 @@ use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
 use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
 use crate::render::frame::{FrameRenderer, Method, RenderedFrame};
-use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
+use crate::render::splat::FrameInput;
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -42,23 +42,8 @@ pub struct CompareArgs {
     /// Depth slices for the slice method.
     #[arg(long, default_value_t = 41)]
     pub slices: usize,
-    /// Splatting tile side in pixels.
-    #[arg(long, default_value_t = 8)]
-    pub tile_size: u32,
-    /// Storage of the PSF texture the splatting samples.
-    #[arg(long, value_enum, default_value = "rgba16f")]
-    pub texture_format: PsfTextureFormat,
-    /// Levels of block merging in the splatting (0 = none).
-    #[arg(long, default_value_t = 1)]
-    pub merge_levels: u32,
     #[command(flatten)]
-    pub blend: super::BlendArgs,
-    /// Merge a block only if its smallest blur radius is at least this (px).
-    #[arg(long, default_value_t = 5.0)]
-    pub merge_min_radius: f32,
-    /// Largest colour difference inside a merged block, per pixel of blur radius.
-    #[arg(long, default_value_t = 0.10)]
-    pub merge_color_tolerance: f32,
+    pub splat: super::SplatArgs,
     /// Object-distance samples over the seed paper's 0.125–10.125 D range (its 41 by default).
     #[arg(long, default_value_t = 41)]
     pub object_samples: usize,
@@ -136,17 +121,7 @@ fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
 }
 
 pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
-    let splat = super::splat_settings(
-        args.tile_size,
-        args.texture_format,
-        MergeSettings {
-            levels: args.merge_levels,
-            min_radius_px: args.merge_min_radius,
-            color_tolerance: args.merge_color_tolerance,
-            ..MergeSettings::default()
-        },
-        &args.blend,
-    )?;
+    let splat = args.splat.settings()?;
     if args.slices == 0 {
         return Err(Error::input("--slices must be at least 1"));
     }

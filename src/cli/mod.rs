@@ -140,25 +140,55 @@ impl BlendArgs {
 }
 
 /// Splat settings from the command line, validated (errors name the options).
-pub(crate) fn splat_settings(
-    tile_size: u32,
-    texture_format: crate::render::splat::PsfTextureFormat,
-    merge: crate::render::splat::MergeSettings,
-    blend: &BlendArgs,
-) -> Result<crate::render::splat::SplatSettings> {
-    let settings = crate::render::splat::SplatSettings {
-        tile_size,
-        texture_format,
-        merge,
-        blend: blend.settings(),
-        ..crate::render::splat::SplatSettings::default()
-    };
-    settings.validate().map_err(|e| {
-        crate::Error::input(format!(
-            "--tile-size / --merge-* / --group-tolerance-d: {e}"
-        ))
-    })?;
-    Ok(settings)
+/// The splatting options of render, bench and compare: one struct, flattened into each.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SplatArgs {
+    /// Screen tile side for splatting in pixels: 8, 16 or 32.
+    #[arg(long, default_value_t = 8)]
+    pub tile_size: u32,
+    /// Storage of the PSF texture the splatting samples.
+    #[arg(long, value_enum, default_value = "rgba16f")]
+    pub texture_format: crate::render::splat::PsfTextureFormat,
+    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4 blocks.
+    #[arg(long, default_value_t = 1)]
+    pub merge_levels: u32,
+    /// Merge a block only if its smallest blur radius is at least this (px).
+    #[arg(
+        long,
+        value_name = "PX",
+        default_value_t = 5.0,
+        allow_hyphen_values = true
+    )]
+    pub merge_min_radius: f32,
+    /// Largest colour difference inside a merged block, per pixel of blur radius.
+    #[arg(long, default_value_t = 0.10, allow_hyphen_values = true)]
+    pub merge_color_tolerance: f32,
+    #[command(flatten)]
+    pub blend: BlendArgs,
+}
+
+impl SplatArgs {
+    /// The validated settings; errors name the options.
+    pub(crate) fn settings(&self) -> Result<crate::render::splat::SplatSettings> {
+        let settings = crate::render::splat::SplatSettings {
+            tile_size: self.tile_size,
+            texture_format: self.texture_format,
+            merge: crate::render::splat::MergeSettings {
+                levels: self.merge_levels,
+                min_radius_px: self.merge_min_radius,
+                color_tolerance: self.merge_color_tolerance,
+                ..crate::render::splat::MergeSettings::default()
+            },
+            blend: self.blend.settings(),
+            ..crate::render::splat::SplatSettings::default()
+        };
+        settings.validate().map_err(|e| {
+            crate::Error::input(format!(
+                "--tile-size / --merge-* / --group-tolerance-d: {e}"
+            ))
+        })?;
+        Ok(settings)
+    }
 }
 
 /// Kernel options honouring `--cache DIR` and `--no-cache`.
@@ -166,13 +196,58 @@ pub(crate) fn kernel_options(
     cache: Option<&std::path::PathBuf>,
     no_cache: bool,
 ) -> crate::render::frame::KernelOptions {
-    let mut options = crate::render::frame::KernelOptions::default();
+    let mut options = crate::render::frame::KernelOptions {
+        progress: Some(kernel_progress_bar()),
+        ..crate::render::frame::KernelOptions::default()
+    };
     if no_cache {
         options.cache_dir = None;
     } else if let Some(dir) = cache {
         options.cache_dir = Some(dir.clone());
     }
     options
+}
+
+/// A progress bar for kernel computation on a terminal (hidden otherwise); it clears itself
+/// when the last stage completes.
+fn kernel_progress_bar() -> crate::render::frame::ProgressHook {
+    use crate::psf::grid::Stage;
+    use std::io::IsTerminal;
+    let bar = if std::io::stderr().is_terminal() {
+        indicatif::ProgressBar::new(0).with_style(
+            indicatif::ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} ETA {eta}")
+                .expect("static template")
+                .progress_chars("=> "),
+        )
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    std::sync::Arc::new(move |stage: Stage, done: usize, total: usize| {
+        let label = match stage {
+            Stage::Optics => "eye optics",
+            Stage::Psfs => "PSFs",
+            Stage::Kernels => "kernels",
+        };
+        bar.set_message(label);
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+        if matches!(stage, Stage::Kernels) && done >= total {
+            bar.finish_and_clear();
+        }
+    })
+}
+
+/// Loads or computes kernels (`render::frame::prepare_kernels`) and prints their warnings.
+pub(crate) fn prepare_kernels(
+    eye: &crate::eye::Eye,
+    needs: &crate::psf::plan::SceneNeeds,
+    options: &crate::render::frame::KernelOptions,
+) -> Result<crate::render::frame::PreparedKernels> {
+    let kernels = crate::render::frame::prepare_kernels(eye, needs, options)?;
+    for w in &kernels.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(kernels)
 }
 
 /// A scene rasterised at t = 0 with the eye state the measuring commands (bench, compare)
@@ -225,7 +300,7 @@ pub(crate) fn frame_kernels(
         screen.fov_y_deg,
     );
     let needs = crate::render::frame::scene_needs(&[range], &[state], screen);
-    crate::render::frame::prepare_kernels(eye, &needs, options)
+    prepare_kernels(eye, &needs, options)
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder and a rename, so a

@@ -14,10 +14,8 @@ use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
 use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
 use crate::psf::cache::CacheOutcome;
-use crate::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, Method,
-};
-use crate::render::splat::{FrameInput, MergeSettings, PsfTextureFormat};
+use crate::render::frame::{dioptre_range, scene_needs, EyeState, FrameRenderer, Method};
+use crate::render::splat::FrameInput;
 use crate::render::Rasterizer;
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -134,17 +132,8 @@ pub struct RenderArgs {
     /// Rendering method.
     #[arg(long, value_enum, default_value = "splat")]
     pub method: Method,
-    /// Screen tile size for splatting: 8, 16 or 32.
-    #[arg(long, default_value_t = 8)]
-    pub tile_size: u32,
-    /// PSF texture format.
-    #[arg(long, value_enum, default_value = "rgba16f")]
-    pub texture_format: PsfTextureFormat,
-    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4.
-    #[arg(long, default_value_t = 1)]
-    pub merge_levels: u32,
     #[command(flatten)]
-    pub blend: super::BlendArgs,
+    pub splat: super::SplatArgs,
     /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
@@ -492,15 +481,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             args.output.display()
         )));
     }
-    let splat = super::splat_settings(
-        args.tile_size,
-        args.texture_format,
-        MergeSettings {
-            levels: args.merge_levels,
-            ..MergeSettings::default()
-        },
-        &args.blend,
-    )?;
+    let splat = args.splat.settings()?;
     if let Some(fov) = args.fov_y {
         check_fov(fov)?;
     }
@@ -551,7 +532,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         &[state],
         screen,
     );
-    let kernels = prepare_kernels(&eye, &needs, &options)?;
+    let kernels = super::prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
     let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
     let missed = kernels

@@ -21,9 +21,7 @@ use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
 use crate::optics::pupil::{watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
-use crate::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, Method,
-};
+use crate::render::frame::{dioptre_range, scene_needs, EyeState, FrameRenderer, Method};
 use crate::render::splat::{FrameInput, SplatSettings};
 use crate::render::{Frame, Rasterizer};
 use crate::scene::{FrameState, Scene};
@@ -487,7 +485,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     if !todo.is_empty() {
         let needs = scene_needs(&ranges, &states, screen);
         for (_, eye) in &eyes {
-            let kernels = prepare_kernels(eye, &needs, &options)?;
+            let kernels = super::prepare_kernels(eye, &needs, &options)?;
             renderers.push(FrameRenderer::new(
                 &ctx,
                 eye.clone(),

@@ -103,7 +103,7 @@ struct Module {
 
 /// Reads `spirv` (bytes of a SPIR-V module). Errors name what is malformed.
 pub fn reflect(spirv: &[u8]) -> Result<Reflection, String> {
-    if spirv.len() % 4 != 0 || spirv.len() < 20 {
+    if !spirv.len().is_multiple_of(4) || spirv.len() < 20 {
         return Err("not a SPIR-V module (length)".into());
     }
     let words: Vec<u32> = spirv

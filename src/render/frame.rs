@@ -47,15 +47,30 @@ pub struct EyeState {
 }
 
 /// Where kernels come from and how they are computed.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct KernelOptions {
     pub settings: KernelSettings,
     /// The grid whose spacing planned axes follow (the seed paper's by default).
     pub reference_axes: GridAxes,
     /// None: no cache.
     pub cache_dir: Option<PathBuf>,
-    /// Show a progress bar on a terminal.
-    pub progress: bool,
+    /// Told the stage and count as kernels are computed (the CLI draws a progress bar with it;
+    /// the library prints nothing).
+    pub progress: Option<ProgressHook>,
+}
+
+/// A progress callback: (stage, done, total).
+pub type ProgressHook = std::sync::Arc<dyn Fn(Stage, usize, usize) + Send + Sync>;
+
+impl std::fmt::Debug for KernelOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("KernelOptions")
+            .field("settings", &self.settings)
+            .field("reference_axes", &self.reference_axes)
+            .field("cache_dir", &self.cache_dir)
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
 }
 
 impl Default for KernelOptions {
@@ -64,7 +79,7 @@ impl Default for KernelOptions {
             settings: KernelSettings::default(),
             reference_axes: GridAxes::default(),
             cache_dir: cache::default_cache_dir(),
-            progress: true,
+            progress: None,
         }
     }
 }
@@ -78,6 +93,9 @@ pub struct PreparedKernels {
     pub report: Option<GridReport>,
     pub cache: CacheOutcome,
     pub seconds: f64,
+    /// What a user must hear about these kernels: PSFs that miss pupil energy beyond the
+    /// limit, a cache that could not be written.
+    pub warnings: Vec<String>,
 }
 
 /// Smallest and largest object vergence (along each pixel's ray; infinity = 0 D) of a
@@ -128,34 +146,21 @@ pub fn prepare_kernels(
     let started = Instant::now();
     let plan = plan_for_scene(needs, &options.reference_axes).map_err(Error::input)?;
     let key = cache::grid_key(eye, &plan.axes, &plan.screen, &options.settings);
-    let bar = options.progress.then(|| progress_bar(plan.psfs));
     let progress = |stage: Stage, done: usize, total: usize| {
-        if let Some(bar) = &bar {
-            let label = match stage {
-                Stage::Optics => "eye optics",
-                Stage::Psfs => "PSFs",
-                Stage::Kernels => "kernels",
-            };
-            bar.set_message(label);
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
+        if let Some(hook) = &options.progress {
+            hook(stage, done, total);
         }
     };
     let (grid, report, outcome) = cache::cached(options.cache_dir.as_deref(), &key, || {
         compute_grid(eye, &plan.axes, &plan.screen, &options.settings, &progress)
     })?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
     // a kernel whose PSF misses pupil energy beyond the limit is never silent
-    for w in report.iter().flat_map(|r| &r.warnings) {
-        eprintln!("warning: {w}");
-    }
+    let mut warnings: Vec<String> = report.iter().flat_map(|r| r.warnings.clone()).collect();
     match &outcome {
         CacheOutcome::Stored {
             warning: Some(w), ..
-        } => eprintln!("warning: {w}"),
-        CacheOutcome::WriteFailed(w) => eprintln!("warning: kernels not cached: {w}"),
+        } => warnings.push(w.clone()),
+        CacheOutcome::WriteFailed(w) => warnings.push(format!("kernels not cached: {w}")),
         _ => {}
     }
     Ok(PreparedKernels {
@@ -164,21 +169,8 @@ pub fn prepare_kernels(
         report,
         cache: outcome,
         seconds: started.elapsed().as_secs_f64(),
+        warnings,
     })
-}
-
-fn progress_bar(total: usize) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(total as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} ETA {eta}")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    bar
 }
 
 /// A rendered frame and what it cost.

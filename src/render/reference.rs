@@ -17,44 +17,8 @@ use super::splat::FrameInput;
 /// Bin width of the ground truth's dioptre quantisation (the seed paper's 3 decimals).
 pub const DIOPTRE_BIN_D: f64 = 0.001;
 
-/// A square kernel of side 2·radius + 1, row-major, row j ↔ screen offset dy = j − radius
-/// (downwards), column i ↔ dx = i − radius; normalised to sum 1.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Kernel {
-    pub radius: u32,
-    pub values: Vec<f32>,
-}
-
-impl Kernel {
-    pub fn side(&self) -> usize {
-        2 * self.radius as usize + 1
-    }
-
-    /// Weight at offset (dx, dy) from the centre; zero outside.
-    pub fn at(&self, dx: i64, dy: i64) -> f32 {
-        let r = self.radius as i64;
-        if dx.abs() > r || dy.abs() > r {
-            return 0.0;
-        }
-        self.values[((dy + r) * (2 * r + 1) + dx + r) as usize]
-    }
-
-    /// Bilinear interpolation between texels at a fractional offset (zero outside), as a
-    /// texture with linear filtering and a zero border samples it.
-    pub fn sample(&self, dx: f64, dy: f64) -> f32 {
-        let (x0, y0) = (dx.floor(), dy.floor());
-        let (tx, ty) = ((dx - x0) as f32, (dy - y0) as f32);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        (1.0 - ty) * ((1.0 - tx) * self.at(x0, y0) + tx * self.at(x0 + 1, y0))
-            + ty * ((1.0 - tx) * self.at(x0, y0 + 1) + tx * self.at(x0 + 1, y0 + 1))
-    }
-}
-
-/// The exact kernel for a channel (0 = R, 1 = G, 2 = B) at an object vergence in dioptres, for
-/// the frame's pupil, focus, resolution and field of view.
-pub trait ExactKernels: Sync {
-    fn kernel(&self, channel: usize, dioptre: f64) -> Kernel;
-}
+// The kernel types live with the exact PSFs in `psf`; the renderers here consume them.
+pub use crate::psf::exact::{ExactKernels, Kernel};
 
 /// Vergence of a depth in metres; 0, negative, NaN or infinite depth is optical infinity.
 pub fn dioptre_of_depth(depth_m: f32) -> f64 {
