@@ -168,7 +168,7 @@ impl Measurer {
         let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
         let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
         let radius = pupil_mm / 2.0;
-        let launch = launcher(object_distance_m, radius, ep_z);
+        let launch = launcher(object_distance_m, radius, ep_z, first_z(sys))?;
 
         let mut chief = launch(0.0, 0.0);
         trace_range(sys, &n, &mut chief, 0..ns).map_err(|v| {
@@ -269,7 +269,7 @@ impl Measurer {
         let py = paraxial(sys, wavelength_nm, 90.0);
         let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
         let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
-        let launch = launcher(object_distance_m, pupil_mm / 2.0, ep_z);
+        let launch = launcher(object_distance_m, pupil_mm / 2.0, ep_z, first_z(sys))?;
         let mut chief = launch(0.0, 0.0);
         trace_range(sys, &n, &mut chief, 0..ns)
             .map_err(|v| EyeError::Invalid(format!("chief ray vignetted ({v:?})")))?;
@@ -338,19 +338,42 @@ fn check_inputs(
     Ok(())
 }
 
-/// Ray factory for normalised pupil coordinates (u, v) on the entrance pupil.
-fn launcher(object_distance_m: Option<f64>, radius_mm: f64, ep_z: f64) -> impl Fn(f64, f64) -> Ray {
-    move |u: f64, v: f64| match object_distance_m {
+/// The frontmost vertex of the system (a spectacle lens lies before the cornea).
+fn first_z(sys: &OpticalSystem) -> f64 {
+    sys.surfaces
+        .iter()
+        .map(|s| s.vertex_z_mm)
+        .fold(0.0, f64::min)
+}
+
+/// Ray factory for normalised pupil coordinates (u, v) on the entrance pupil; a plane wave
+/// starts 5 mm before the first surface, and a point object must lie before it.
+fn launcher(
+    object_distance_m: Option<f64>,
+    radius_mm: f64,
+    ep_z: f64,
+    first_z_mm: f64,
+) -> Result<impl Fn(f64, f64) -> Ray, EyeError> {
+    if let Some(d) = object_distance_m {
+        if -1000.0 * d >= first_z_mm {
+            return Err(EyeError::Invalid(format!(
+                "an object {d} m from the cornea lies behind the lens {:.1} mm in front of it",
+                -first_z_mm
+            )));
+        }
+    }
+    let start_z = first_z_mm - 5.0;
+    Ok(move |u: f64, v: f64| match object_distance_m {
         Some(d) => Ray::towards(
             [0.0, 0.0, -1000.0 * d],
             [radius_mm * u, radius_mm * v, ep_z],
         ),
         None => Ray {
-            p: [radius_mm * u, radius_mm * v, -5.0],
+            p: [radius_mm * u, radius_mm * v, start_z],
             d: [0.0, 0.0, 1.0],
             opl_mm: 0.0,
         },
-    }
+    })
 }
 
 #[inline]
