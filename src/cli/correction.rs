@@ -160,6 +160,46 @@ impl CorrectionArgs {
     }
 }
 
+impl CorrectionArgs {
+    /// The eyes of a side-by-side export, labelled: `--eye` with these options, and the
+    /// `--side-by-side` eye (`uncorrected`: the same eye without the correction) with only the
+    /// amplitude options.
+    pub fn labelled_eyes(
+        &self,
+        spec: &str,
+        eye: Eye,
+        side_by_side: Option<&str>,
+        load: impl Fn(&str) -> Result<Eye>,
+        age: Option<(f64, HofstetterLine)>,
+    ) -> Result<Vec<(String, Eye)>> {
+        let (corrected, physiology) = self.apply(&eye, age)?;
+        let label = match (&physiology.correction, physiology.iol_d) {
+            (Some(c), _) => format!("{spec} {c}"),
+            (None, Some(p)) => format!("{spec} IOL {p:.1} D"),
+            _ => spec.to_string(),
+        };
+        let mut eyes = vec![(label, corrected)];
+        if let Some(other) = side_by_side {
+            let (e, label) = if other.eq_ignore_ascii_case("uncorrected") {
+                if !self.corrects() {
+                    return Err(Error::input(
+                        "--side-by-side uncorrected compares with --correct or --iol-d; neither is given",
+                    ));
+                }
+                (eye, format!("{spec} uncorrected"))
+            } else {
+                (load(other)?, other.to_string())
+            };
+            let plain = CorrectionArgs {
+                accommodation_max_d: self.accommodation_max_d,
+                ..Default::default()
+            };
+            eyes.push((label, plain.apply(&e, age)?.0));
+        }
+        Ok(eyes)
+    }
+}
+
 /// `-6.50 +0.00 x 180 at 12 mm` (or `as a contact lens`).
 pub fn describe(s: &Spectacle) -> String {
     if s.vertex_mm == 0.0 {

@@ -70,9 +70,12 @@ pub struct VideoArgs {
     /// Frame size (default: the scene's `resolution`).
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
-    /// Render every frame through this second eye as well, side by side and labelled.
-    #[arg(long, value_name = "NAME|FILE")]
+    /// Render every frame through this second eye as well, side by side and labelled;
+    /// `uncorrected` is the --eye without --correct/--iol-d.
+    #[arg(long, value_name = "NAME|FILE|uncorrected")]
     pub side_by_side: Option<String>,
+    #[command(flatten)]
+    pub correction: super::correction::CorrectionArgs,
     /// Fixed camera (the scene at t = 0); focus moves from NEAR to FAR metres, linearly in
     /// dioptres.
     #[arg(long, value_name = "NEAR..FAR")]
@@ -361,10 +364,14 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         Some(text) => parse_range(text, count).map_err(Error::input)?,
         None => (0, count),
     };
-    let mut eyes: Vec<(String, Eye)> = vec![(args.eye.clone(), load_eye_for("--eye", &args.eye)?)];
-    if let Some(spec) = &args.side_by_side {
-        eyes.push((spec.clone(), load_eye_for("--side-by-side", spec)?));
-    }
+    // The pupil model's age (30 years) also sets the amplitude of accommodation, as in render.
+    let eyes = args.correction.labelled_eyes(
+        &args.eye,
+        load_eye_for("--eye", &args.eye)?,
+        args.side_by_side.as_deref(),
+        |spec| load_eye_for("--side-by-side", spec),
+        Some((30.0, crate::eye::age::HofstetterLine::Mean)),
+    )?;
     if args.output.exists() && !args.output.is_dir() {
         return Err(Error::file(
             &args.output,

@@ -142,18 +142,7 @@ pub fn focus_within_range(
     far_point_limit: bool,
 ) -> Result<Focused, EyeError> {
     if eye.iol.is_some() {
-        let sys = eye.system()?;
-        let mut buf = [0.0; 15];
-        fast_measurer().coefficients_um(
-            &sys,
-            wavelength_nm,
-            pupil_mm,
-            object_distance_m,
-            &mut buf,
-        )?;
-        // Positive c(2,0): the eye focuses nearer than the object (the object lies beyond
-        // its far point); negative: farther.
-        let error_d = 4.0 * 3f64.sqrt() * buf[osa_index(2, 0)] / (pupil_mm / 2.0).powi(2);
+        let error_d = focus_error_d(eye, object_distance_m, pupil_mm, wavelength_nm)?;
         let limit = if error_d.abs() < 0.01 {
             FocusLimit::Reached
         } else if error_d > 0.0 {
@@ -184,9 +173,16 @@ pub fn focus_within_range(
         Err(e) => return Err(e),
     };
     if far_point_limit && acc.diameter_mm > d0 {
+        // Within 0.01 D of the far point (a prescription rounded to 0.01 D) counts as reached.
+        let limit = if focus_error_d(eye, object_distance_m, pupil_mm, wavelength_nm)?.abs() < 0.01
+        {
+            FocusLimit::Reached
+        } else {
+            FocusLimit::FarPoint
+        };
         return Ok(Focused {
             eye: eye.clone(),
-            limit: FocusLimit::FarPoint,
+            limit,
         });
     }
     if let Some(d_min) = near_limit {
@@ -201,6 +197,20 @@ pub fn focus_within_range(
         eye: acc.eye,
         limit: FocusLimit::Reached,
     })
+}
+
+/// How far (D) `eye` as it is focuses nearer than the object: positive when the object lies
+/// beyond its focus (c(2,0) > 0), negative when nearer.
+fn focus_error_d(
+    eye: &Eye,
+    object_distance_m: Option<f64>,
+    pupil_mm: f64,
+    wavelength_nm: f64,
+) -> Result<f64, EyeError> {
+    let sys = eye.system()?;
+    let mut buf = [0.0; 15];
+    fast_measurer().coefficients_um(&sys, wavelength_nm, pupil_mm, object_distance_m, &mut buf)?;
+    Ok(4.0 * 3f64.sqrt() * buf[osa_index(2, 0)] / (pupil_mm / 2.0).powi(2))
 }
 
 /// The bare eye's refraction (D) for a distant object at lens diameter `diameter_mm`.
