@@ -45,7 +45,15 @@ fn every_new_option_is_range_checked_at_the_parser() {
     for (extra, option) in cases {
         for cmd in [
             &["render", "--scene", "chart", "-o", "/nonexistent/x.png"][..],
-            &["eye", "measure", "myopia", "--pupil-mm", "4", "--wavelength-nm", "549"][..],
+            &[
+                "eye",
+                "measure",
+                "myopia",
+                "--pupil-mm",
+                "4",
+                "--wavelength-nm",
+                "549",
+            ][..],
         ] {
             let mut args = cmd.to_vec();
             args.extend_from_slice(extra);
@@ -60,7 +68,11 @@ fn every_new_option_is_range_checked_at_the_parser() {
             assert!(!text.contains("panicked"));
         }
     }
-    for bad in [["--pupil-mm", "0.5"], ["--vertex-mm", "17"], ["--wavelength-nm", "900"]] {
+    for bad in [
+        ["--pupil-mm", "0.5"],
+        ["--vertex-mm", "17"],
+        ["--wavelength-nm", "900"],
+    ] {
         let o = ocular(&["eye", "refract", "myopia", bad[0], bad[1]]);
         let text = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{text}");
@@ -76,13 +88,30 @@ fn prescription_to_eye_to_prescription_closes() {
     // The estimated eye's wavefront is this prescription at its entrance pupil.
     let (s, c, a) = (-2.5, -1.25, 30.0);
     let o = ocular(&[
-        "eye", "estimate", "--rx", "-2.5 -1.25 x 30", "--pupil-mm", "4", "--wavelength-nm",
-        "549", "--threads", "1", "-o", eye,
+        "eye",
+        "estimate",
+        "--rx",
+        "-2.5 -1.25 x 30",
+        "--pupil-mm",
+        "4",
+        "--wavelength-nm",
+        "549",
+        "--threads",
+        "1",
+        "-o",
+        eye,
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for vertex in ["0", "12"] {
         let r = json_ok(&ocular(&[
-            "eye", "refract", eye, "--pupil-mm", "4", "--vertex-mm", vertex, "--json",
+            "eye",
+            "refract",
+            eye,
+            "--pupil-mm",
+            "4",
+            "--vertex-mm",
+            vertex,
+            "--json",
         ]));
         // Independent: each principal meridian's power K at the entrance pupil moves to
         // F = K / (1 + dK) at the lens, d from the lens to the pupil.
@@ -93,14 +122,31 @@ fn prescription_to_eye_to_prescription_closes() {
         let got_s = r["sphere_d"].as_f64().unwrap();
         let got_c = r["cylinder_d"].as_f64().unwrap();
         let got_a = r["axis_deg"].as_f64().unwrap();
-        assert!((got_s - f1).abs() < 0.05, "vertex {vertex}: S {got_s} vs {f1}");
-        assert!((got_c - (f2 - f1)).abs() < 0.05, "vertex {vertex}: C {got_c} vs {}", f2 - f1);
+        assert!(
+            (got_s - f1).abs() < 0.05,
+            "vertex {vertex}: S {got_s} vs {f1}"
+        );
+        assert!(
+            (got_c - (f2 - f1)).abs() < 0.05,
+            "vertex {vertex}: C {got_c} vs {}",
+            f2 - f1
+        );
         assert!((got_a - a).abs() < 1.0, "vertex {vertex}: axis {got_a}");
         // The printed form goes straight back in as --correct and corrects the eye.
         let rx = r["rx"].as_str().unwrap();
         let m = json_ok(&ocular(&[
-            "eye", "measure", eye, "--pupil-mm", "4", "--wavelength-nm", "549", "--correct", rx,
-            "--vertex-mm", vertex, "--json",
+            "eye",
+            "measure",
+            eye,
+            "--pupil-mm",
+            "4",
+            "--wavelength-nm",
+            "549",
+            "--correct",
+            rx,
+            "--vertex-mm",
+            vertex,
+            "--json",
         ]));
         for k in ["m", "j0", "j45"] {
             let v = m["refraction"][k].as_f64().unwrap();
@@ -109,8 +155,18 @@ fn prescription_to_eye_to_prescription_closes() {
         // Negative control: the same lens at the other vertex distance leaves an error.
         let other = if vertex == "0" { "12" } else { "0" };
         let m = json_ok(&ocular(&[
-            "eye", "measure", eye, "--pupil-mm", "4", "--wavelength-nm", "549", "--correct", rx,
-            "--vertex-mm", other, "--json",
+            "eye",
+            "measure",
+            eye,
+            "--pupil-mm",
+            "4",
+            "--wavelength-nm",
+            "549",
+            "--correct",
+            rx,
+            "--vertex-mm",
+            other,
+            "--json",
         ]));
         assert!(m["refraction"]["m"].as_f64().unwrap().abs() > 0.05);
     }
@@ -124,8 +180,20 @@ fn render_reports_the_near_point_and_reading_glasses_move_it() {
     let render = |extra: &[&str]| {
         let out = dir.join("out.png");
         let mut args = vec![
-            "render", "--scene", "chart", "--eye", "healthy", "--size", "160x90", "--focus-m",
-            "0.4", "--json", "--cache", cache.to_str().unwrap(), "-o", out.to_str().unwrap(),
+            "render",
+            "--scene",
+            "chart",
+            "--eye",
+            "healthy",
+            "--size",
+            "160x90",
+            "--focus-m",
+            "0.4",
+            "--json",
+            "--cache",
+            cache.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
         json_ok(&ocular(&args))
@@ -155,12 +223,28 @@ fn render_reports_the_near_point_and_reading_glasses_move_it() {
 fn the_myopic_eye_focuses_far_only_through_its_prescription() {
     let dir = temp_dir("myopia");
     let rx = ocular(&["eye", "refract", "myopia"]);
-    let rx = String::from_utf8_lossy(&rx.stdout).lines().next().unwrap().to_string();
+    let rx = String::from_utf8_lossy(&rx.stdout)
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
     let render = |extra: &[&str]| {
         let out = dir.join("out.png");
         let mut args = vec![
-            "render", "--scene", "primitives", "--eye", "myopia", "--size", "160x90",
-            "--focus-m", "inf", "--pupil-mm", "4", "--json", "--no-cache", "-o",
+            "render",
+            "--scene",
+            "primitives",
+            "--eye",
+            "myopia",
+            "--size",
+            "160x90",
+            "--focus-m",
+            "inf",
+            "--pupil-mm",
+            "4",
+            "--json",
+            "--no-cache",
+            "-o",
             out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);

@@ -71,7 +71,11 @@ fn a_contact_lens_needs_no_vertex_correction_beyond_the_pupil_depth() {
     let (m0, _, _, ep_z) = far_refraction(&eye, 4.0);
     let rx = refract(&eye, 4.0, 0.0, NM).unwrap();
     let expected = m0 / (1.0 + ep_z * 1e-3 * m0);
-    assert!((rx.sphere_d - expected).abs() < 0.03, "{} vs {expected}", rx.sphere_d);
+    assert!(
+        (rx.sphere_d - expected).abs() < 0.03,
+        "{} vs {expected}",
+        rx.sphere_d
+    );
     let (m, _, _, _) = far_refraction(&with_lens(&eye, rx.sphere_d, 0.0), 4.0);
     assert!(m.abs() < 0.05, "through the contact lens M {m}");
 }
@@ -112,7 +116,10 @@ fn an_over_correction_by_one_dioptre_needs_the_vergence_formulas_accommodation()
     let right = with_lens(&eye, f, 12.0);
     let near = focus_within_range(&right, Some(1.012), pupil, NM, true).unwrap();
     let exerted_near = exerted_accommodation_d(&eye, near.eye.lens.diameter_mm, pupil, NM).unwrap();
-    assert!((exerted - exerted_near).abs() < 0.03, "{exerted} vs {exerted_near}");
+    assert!(
+        (exerted - exerted_near).abs() < 0.03,
+        "{exerted} vs {exerted_near}"
+    );
     // An amplitude below it cannot focus far through the over-correction.
     let mut weak = over.clone();
     weak.accommodation_max_d = Some(0.5 * expected);
@@ -120,7 +127,9 @@ fn an_over_correction_by_one_dioptre_needs_the_vergence_formulas_accommodation()
     assert_eq!(clamped.limit, FocusLimit::NearPoint);
     weak.accommodation_max_d = Some(expected + 0.1);
     assert_eq!(
-        focus_within_range(&weak, None, pupil, NM, true).unwrap().limit,
+        focus_within_range(&weak, None, pupil, NM, true)
+            .unwrap()
+            .limit,
         FocusLimit::Reached
     );
 }
@@ -153,7 +162,9 @@ fn spot_r50_arcmin(eye: &Eye, distance_m: f64, pupil_mm: f64) -> f64 {
             pts.push([p[0], p[1]]);
         }
     }
-    let c = pts.iter().fold([0.0, 0.0], |a, p| [a[0] + p[0], a[1] + p[1]]);
+    let c = pts
+        .iter()
+        .fold([0.0, 0.0], |a, p| [a[0] + p[0], a[1] + p[1]]);
     let c = [c[0] / pts.len() as f64, c[1] / pts.len() as f64];
     let mut r: Vec<f64> = pts
         .iter()
@@ -194,9 +205,13 @@ fn a_sixty_year_old_emmetrope_cannot_read_the_card_at_forty_centimetres_a_twenty
         .measure(&f.eye.system().unwrap(), NM, pupil, Some(0.4))
         .unwrap();
     let defocus_d = m.refraction.m.abs();
-    let disc_r50 = defocus_d * pupil / 2.0 * 1e-3 / 2f64.sqrt() * (180.0 / std::f64::consts::PI) * 60.0;
+    let disc_r50 =
+        defocus_d * pupil / 2.0 * 1e-3 / 2f64.sqrt() * (180.0 / std::f64::consts::PI) * 60.0;
     assert!(defocus_d > 1.5, "defocus {defocus_d} D");
-    assert!((old - disc_r50).abs() < 0.25 * disc_r50, "r50 {old} vs disc {disc_r50}");
+    assert!(
+        (old - disc_r50).abs() < 0.25 * disc_r50,
+        "r50 {old} vs disc {disc_r50}"
+    );
 }
 
 #[test]
@@ -237,7 +252,10 @@ fn the_emmetropic_iol_agrees_with_the_thin_lens_vergence_formula_and_does_not_ac
     v = v / (1.0 - gap / n_a * v);
     let needed = n_v / ((eye.axial_length_mm - z_iol) * 1e-3);
     let formula = needed - v;
-    assert!((p - formula).abs() < 0.15, "traced {p} D vs formula {formula} D");
+    assert!(
+        (p - formula).abs() < 0.15,
+        "traced {p} D vs formula {formula} D"
+    );
     let mut pseudo = eye.clone();
     pseudo.iol = Some(Iol { power_d: p });
     let (m, _, _, _) = far_refraction(&pseudo, 1.0);
@@ -252,4 +270,32 @@ fn the_emmetropic_iol_agrees_with_the_thin_lens_vergence_formula_and_does_not_ac
         .measure(&reading.system().unwrap(), NM, 3.0, Some(0.4))
         .unwrap();
     assert!(m.refraction.m.abs() < 0.15, "{}", m.refraction.m);
+}
+
+#[test]
+fn eye_files_carry_the_amplitude_and_the_correction_and_refuse_bad_values() {
+    let base = file::preset("healthy").unwrap().eye.to_toml_string();
+    let text = format!(
+        "accommodation_max_d = 0.5\n{base}\n[correction]\nsphere_d = 2.0\nvertex_mm = 12.0\n"
+    );
+    let eye = Eye::from_toml_str(&text).unwrap();
+    assert_eq!(eye.accommodation_max_d, Some(0.5));
+    assert_eq!(eye.correction.unwrap().sphere_d, 2.0);
+    assert_eq!(eye.correction.unwrap().axis_deg, 180.0);
+    // Round trip through the writer.
+    assert_eq!(Eye::from_toml_str(&eye.to_toml_string()).unwrap(), eye);
+    for (bad, field) in [
+        ("accommodation_max_d = 30.0\n", "accommodation_max_d"),
+        ("accommodation_max_d = -1.0\n", "accommodation_max_d"),
+    ] {
+        let e = Eye::from_toml_str(&format!("{bad}{base}")).unwrap_err();
+        assert!(e.to_string().contains(field), "{e}");
+    }
+    let e = Eye::from_toml_str(&format!(
+        "{base}\n[correction]\nsphere_d = -2.0\nvertex_mm = 40.0\n"
+    ))
+    .unwrap_err();
+    assert!(e.to_string().contains("correction.vertex_mm"), "{e}");
+    let e = Eye::from_toml_str(&format!("{base}\n[iol]\npower_d = 60.0\n")).unwrap_err();
+    assert!(e.to_string().contains("iol.power_d"), "{e}");
 }

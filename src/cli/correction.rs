@@ -173,10 +173,17 @@ impl CorrectionArgs {
         age: Option<(f64, HofstetterLine)>,
     ) -> Result<Vec<(String, Eye)>> {
         let (corrected, physiology) = self.apply(&eye, age)?;
-        let label = match (&physiology.correction, physiology.iol_d) {
-            (Some(c), _) => format!("{spec} {c}"),
-            (None, Some(p)) => format!("{spec} IOL {p:.1} D"),
-            _ => spec.to_string(),
+        // Labels fit a panel: the prescription alone when the other panel is the same eye.
+        let same = side_by_side.is_some_and(|o| o.eq_ignore_ascii_case("uncorrected"));
+        let what = match (&e_notation(&corrected), physiology.iol_d) {
+            (Some(c), _) => Some(c.clone()),
+            (None, Some(p)) => Some(format!("IOL {p:.1} D")),
+            _ => None,
+        };
+        let label = match (what, same) {
+            (Some(w), true) => w,
+            (Some(w), false) => format!("{spec} {w}"),
+            (None, _) => spec.to_string(),
         };
         let mut eyes = vec![(label, corrected)];
         if let Some(other) = side_by_side {
@@ -186,7 +193,7 @@ impl CorrectionArgs {
                         "--side-by-side uncorrected compares with --correct or --iol-d; neither is given",
                     ));
                 }
-                (eye, format!("{spec} uncorrected"))
+                (eye, "uncorrected".to_string())
             } else {
                 (load(other)?, other.to_string())
             };
@@ -198,6 +205,10 @@ impl CorrectionArgs {
         }
         Ok(eyes)
     }
+}
+
+fn e_notation(eye: &Eye) -> Option<String> {
+    eye.correction.map(|s| s.notation())
 }
 
 /// `-6.50 +0.00 x 180 at 12 mm` (or `as a contact lens`).

@@ -72,10 +72,7 @@ pub fn run(a: &RefractArgs) -> Result<()> {
         .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
         return print_out(&format!("{text}\n"));
     }
-    print_out(&format!(
-        "{rx}\n{}\n",
-        details(a, &r)
-    ))
+    print_out(&format!("{rx}\n{}\n", details(a, &r)))
 }
 
 /// Writes to stdout; a closed pipe (`| head -1`) ends the command quietly.
@@ -83,9 +80,9 @@ fn print_out(text: &str) -> Result<()> {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(Error::input(format!("cannot write to standard output: {e}")))
-        }
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::input(format!(
+            "cannot write to standard output: {e}"
+        ))),
         _ => Ok(()),
     }
 }

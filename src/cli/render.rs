@@ -330,7 +330,7 @@ pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
 }
 
 /// `--age`: a number of years within the range Watson & Yellott fitted (20 to 83).
-fn parse_age_years(text: &str) -> std::result::Result<f64, String> {
+pub(crate) fn parse_age_years(text: &str) -> std::result::Result<f64, String> {
     let age: f64 = text
         .trim()
         .parse()

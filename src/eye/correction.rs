@@ -100,9 +100,24 @@ impl Spectacle {
 
     pub fn validate(&self) -> Result<(), EyeError> {
         in_range("correction.sphere_d", self.sphere_d, SPHERE_RANGE_D, "D")?;
-        in_range("correction.cylinder_d", self.cylinder_d, (-10.0, 0.0), "D (minus cylinder)")?;
-        in_range("correction.axis_deg", self.axis_deg, (1.0, 180.0), "degrees")?;
-        in_range("correction.vertex_mm", self.vertex_mm, VERTEX_RANGE_MM, "mm")
+        in_range(
+            "correction.cylinder_d",
+            self.cylinder_d,
+            (-10.0, 0.0),
+            "D (minus cylinder)",
+        )?;
+        in_range(
+            "correction.axis_deg",
+            self.axis_deg,
+            (1.0, 180.0),
+            "degrees",
+        )?;
+        in_range(
+            "correction.vertex_mm",
+            self.vertex_mm,
+            VERTEX_RANGE_MM,
+            "mm",
+        )
     }
 
     /// The thin lens in the system: powers along the axis meridian and across it.
@@ -232,12 +247,29 @@ mod tests {
     fn prescriptions_parse_in_every_clinical_spelling() {
         let a = parse_rx("-2.50 -1.00 x 090", 12.0).unwrap();
         assert_eq!((a.sphere_d, a.cylinder_d, a.axis_deg), (-2.5, -1.0, 90.0));
-        for t in ["-2.5 -1x90", "-2.5/-1.0×90", "-2.50 DS / -1.00 DC x 90", "-3.5 +1 x 180"] {
+        for t in [
+            "-2.5 -1x90",
+            "-2.5/-1.0×90",
+            "-2.50 DS / -1.00 DC x 90",
+            "-3.5 +1 x 180",
+        ] {
             let b = parse_rx(t, 12.0).unwrap();
-            assert_eq!((b.sphere_d, b.cylinder_d, b.axis_deg), (-2.5, -1.0, 90.0), "{t}");
+            assert_eq!(
+                (b.sphere_d, b.cylinder_d, b.axis_deg),
+                (-2.5, -1.0, 90.0),
+                "{t}"
+            );
         }
         assert_eq!(parse_rx("+2", 12.0).unwrap().sphere_d, 2.0);
-        for bad in ["", "-2 -1 x 0", "-2 -1 x 181", "-30", "a b x c", "-2 -11 x 90", "-2 -1"] {
+        for bad in [
+            "",
+            "-2 -1 x 0",
+            "-2 -1 x 181",
+            "-30",
+            "a b x c",
+            "-2 -11 x 90",
+            "-2 -1",
+        ] {
             assert!(parse_rx(bad, 12.0).is_err(), "{bad}");
         }
         assert_eq!(a.notation(), "-2.50 -1.00 x 90");

@@ -66,7 +66,11 @@ pub fn rx_to_power_vector(sphere_d: f64, cylinder_d: f64, axis_deg: f64) -> [f64
     ]
 }
 
-fn measure_far(eye: &Eye, pupil_mm: f64, wavelength_nm: f64) -> Result<(Refraction, f64), EyeError> {
+fn measure_far(
+    eye: &Eye,
+    pupil_mm: f64,
+    wavelength_nm: f64,
+) -> Result<(Refraction, f64), EyeError> {
     let m = Measurer::standard().measure(&eye.system()?, wavelength_nm, pupil_mm, None)?;
     Ok((m.refraction, m.entrance_pupil_z_mm))
 }
@@ -130,7 +134,10 @@ mod tests {
         for (s, c, a) in [(-2.0, -1.5, 30.0), (1.0, -0.25, 180.0), (-6.0, 0.0, 180.0)] {
             let pv = rx_to_power_vector(s, c, a);
             let (s2, c2, a2) = power_vector_to_rx(pv[0], pv[1], pv[2]);
-            assert!((s - s2).abs() < 1e-12 && (c - c2).abs() < 1e-12, "{s} {c} {a}");
+            assert!(
+                (s - s2).abs() < 1e-12 && (c - c2).abs() < 1e-12,
+                "{s} {c} {a}"
+            );
             assert!((a - a2).abs() < 1e-9, "{a} vs {a2}");
         }
         // J0 = −(C/2)·cos 2A: a −1 D cylinder at 90° has J0 = −0.5 D.

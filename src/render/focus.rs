@@ -1,9 +1,9 @@
 //! Where the eye focuses: depth → vergence, distances too far to matter, and the far point
 //! of an eye that cannot relax enough.
 
-use crate::eye::{focus_within_range, FocusLimit};
 use crate::eye::measure::Measurer;
 use crate::eye::Eye;
+use crate::eye::{focus_within_range, FocusLimit};
 use crate::optics::zernike::osa_index;
 use crate::psf::axes::{GridAxes, KernelSettings};
 use crate::{Error, Result};
