@@ -518,7 +518,12 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
         println!("with a {p:.2} D IOL");
     }
     if focus_limit != eye::FocusLimit::Reached {
-        println!("focus clamped at the {focus_limit:?} (the eye cannot focus there)");
+        let at = if focus_limit == eye::FocusLimit::FarPoint {
+            "far"
+        } else {
+            "near"
+        };
+        println!("focus clamped at the {at} point (the eye cannot focus there)");
     }
     println!("{:>3} {:>4} {:>12}", "n", "m", "µm");
     for c in m.coefficient_list().iter().skip(1) {
