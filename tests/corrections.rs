@@ -299,3 +299,52 @@ fn eye_files_carry_the_amplitude_and_the_correction_and_refuse_bad_values() {
     let e = Eye::from_toml_str(&format!("{base}\n[iol]\npower_d = 60.0\n")).unwrap_err();
     assert!(e.to_string().contains("iol.power_d"), "{e}");
 }
+
+#[test]
+fn an_ideal_lens_focuses_a_plane_wave_at_its_focal_length_with_equal_paths() {
+    use ocular::eye::media::Medium as M;
+    use ocular::eye::surface::Surface;
+    use ocular::eye::OpticalSystem;
+    // +5 D toric lens (+5 along 30°, +3 across) in air: each principal meridian focuses at
+    // 1/P, and by Fermat every ray of a meridian reaches its focal line with the same
+    // optical path (the added phase and the bending are one consistent lens).
+    let axis = 30f64.to_radians();
+    let sys = OpticalSystem {
+        surfaces: vec![Surface::ideal_lens(0.0, [5.0, 3.0], axis)],
+        media: vec![M::Air],
+        stop_index: 0,
+        stop_z_mm: 0.0,
+        retina_z_mm: 1000.0,
+        lens_index_offset: 0.0,
+    };
+    let n = sys.indices(NM);
+    for (power_d, phi) in [(5.0, axis), (3.0, axis + std::f64::consts::FRAC_PI_2)] {
+        let f_mm = 1000.0 / power_d;
+        let (c, s) = (phi.cos(), phi.sin());
+        let mut paths = Vec::new();
+        for h in [0.5, 1.0, 2.0, 3.0] {
+            let mut ray = Ray {
+                p: [h * c, h * s, -10.0],
+                d: [0.0, 0.0, 1.0],
+                opl_mm: 0.0,
+            };
+            trace_range(&sys, &n, &mut ray, 0..1).unwrap();
+            let t = ray.to_plane(f_mm);
+            let at = ray.at(t);
+            assert!(at[0].hypot(at[1]) < 1e-3 * h, "{power_d} D, h {h}: {at:?}");
+            paths.push(ray.opl_mm + t);
+        }
+        let spread = paths.iter().cloned().fold(f64::MIN, f64::max)
+            - paths.iter().cloned().fold(f64::MAX, f64::min);
+        // A quadratic phase is a paraxial lens: against the exact sphere its paths fall
+        // short by about h⁴/(8f³) (1.3 nm at 3 mm, 200 mm), and its rays, bent by sin θ = h/f,
+        // cross the focal plane a little off; a few times that term bounds the spread, and a
+        // phase and bending that disagreed (say a factor 2 in either) would miss by
+        // h²/(2f) = 22 µm.
+        let quartic = 3f64.powi(4) / (8.0 * f_mm.powi(3));
+        assert!(
+            spread < 4.0 * quartic,
+            "{power_d} D: path spread {spread} mm, quartic term {quartic} mm"
+        );
+    }
+}

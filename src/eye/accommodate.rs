@@ -38,6 +38,19 @@ pub fn accommodate(
     wavelength_nm: f64,
 ) -> Result<Accommodation, EyeError> {
     eye.validate()?;
+    if eye.iol.is_some() {
+        // An IOL has a fixed focus: the eye stays as it is.
+        let sys = eye.system()?;
+        let m = Measurer::standard().measure(&sys, wavelength_nm, pupil_mm, object_distance_m)?;
+        let c = m.coefficient_um(2, 0);
+        return Ok(Accommodation {
+            diameter_mm: eye.lens.diameter_mm,
+            eye: eye.clone(),
+            residual_c20_um: c,
+            residual_d: -4.0 * 3f64.sqrt() * c / (pupil_mm / 2.0).powi(2),
+            iterations: 0,
+        });
+    }
     let meas = fast_measurer();
     let mut buf = [0.0; 15];
     let j20 = osa_index(2, 0);
