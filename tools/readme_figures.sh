@@ -13,6 +13,13 @@ mkdir -p "$out" tools/figures
 # The main job, exactly as the README runs it (default scene, eye and size).
 (cd "$out" && "$OLDPWD/$bin" render -o main.png) && cp "$out/main.png" tools/figures/ocular.png
 
+# Presbyopia (README "Age and corrections"): the chart scene's reading card at 0.4 m through a
+# 60-year-old healthy eye (Hofstetter's mean amplitude, 0.5 D), with +2.00 D readers and without.
+rm -rf "$out/presbyopia"
+"$bin" video --scene tools/recipes/chart_card.toml --eye healthy --age 60 --correct "+2.00" \
+    --side-by-side uncorrected --focus-sweep 0.4..0.4 --duration 0 --size 400x300 \
+    -o "$out/presbyopia" && cp "$out/presbyopia/frame_000000.png" tools/figures/presbyopia.png
+
 for eye in healthy myopia astigmatism keratoconus; do
     "$bin" compare --scene primitives --eye "$eye" --size "$size" --json "$out/compare-$eye.json" \
         --maps "$out/maps-$eye"

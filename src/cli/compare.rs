@@ -36,6 +36,8 @@ pub struct CompareArgs {
     /// Frame size.
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "320x180")]
     pub size: (u32, u32),
+    #[command(flatten)]
+    pub correction: super::correction::CorrectionArgs,
     /// Pupil diameter in mm (default: the scene's, else 5 mm as in the seed paper).
     #[arg(long, value_name = "MM")]
     pub pupil_mm: Option<f64>,
@@ -150,7 +152,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     }
     outputs.probe()?;
     let truth_in = args.truth_in.as_ref().map(read_truth).transpose()?;
-    let eye = load_eye(&args.eye)?;
+    let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
     let (width, height) = args.size;

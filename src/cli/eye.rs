@@ -11,7 +11,7 @@ use super::outputs::Outputs;
 use super::write_atomic;
 use crate::aberrations::{self, ZernikeSet};
 use crate::eye::estimate::{self, Estimate, Method, Progress, Settings};
-use crate::eye::{self, accommodate, file as eye_file};
+use crate::eye::{self, file as eye_file};
 use crate::optics::zernike::Prescription;
 use crate::{Error, Result};
 
@@ -29,6 +29,8 @@ pub enum EyeCommand {
     Show(ShowArgs),
     /// Measure an eye's aberrations, power and refraction.
     Measure(MeasureArgs),
+    /// The spectacle prescription that best corrects an eye ("S C x A", as --correct takes it).
+    Refract(super::refract::RefractArgs),
     /// Draw a cross-section of an eye with ray bundles focused at two distances (SVG).
     Draw(DrawArgs),
     /// List the eye presets and the aberration presets.
@@ -120,6 +122,8 @@ pub struct MeasureArgs {
     /// Print the measurement as JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub correction: super::correction::CorrectionArgs,
 }
 
 #[derive(Debug, Args)]
@@ -146,6 +150,7 @@ pub fn run(args: &EyeArgs) -> Result<()> {
         EyeCommand::Show(a) => run_show(a),
         EyeCommand::Measure(a) => run_measure(a),
         EyeCommand::Draw(a) => run_draw(a),
+        EyeCommand::Refract(a) => super::refract::run(a),
         EyeCommand::List => run_list(),
     }
 }
@@ -401,6 +406,9 @@ fn write_outputs(a: &EstimateArgs, est: &Estimate, command: &str, outputs: &Outp
 fn run_show(a: &ShowArgs) -> Result<()> {
     let f = eye_file::resolve(&a.eye)?;
     check_pupil(a.pupil_mm)?;
+    crate::limits::WAVELENGTH_NM
+        .check("--wavelength-nm", a.wavelength_nm)
+        .map_err(Error::input)?;
     let text = eye::show::describe(&f.eye, a.wavelength_nm, a.pupil_mm)?;
     print!("{text}");
     if let Some(r) = &f.estimate {
@@ -436,6 +444,9 @@ fn parse_focus(s: &str) -> Result<Option<f64>> {
 fn run_measure(a: &MeasureArgs) -> Result<()> {
     let f = eye_file::resolve(&a.eye)?;
     check_pupil(a.pupil_mm)?;
+    crate::limits::WAVELENGTH_NM
+        .check("--wavelength-nm", a.wavelength_nm)
+        .map_err(Error::input)?;
     if !(1..=10).contains(&a.order) {
         return Err(Error::input(format!(
             "--order {} is not allowed; need 1 to 10",
@@ -443,9 +454,16 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
         )));
     }
     let focus = parse_focus(&a.focus_m)?;
-    let focused = match focus {
-        None => f.eye.clone(),
-        Some(_) => accommodate(&f.eye, focus, a.pupil_mm, a.wavelength_nm)?.eye,
+    let (eye, physiology) = a.correction.apply(&f.eye, None)?;
+    // A plain eye is measured as given at infinity and accommodates to any nearer focus, as
+    // before; with an amplitude or an IOL it stays within its range.
+    let limited = eye.accommodation_max_d.is_some() || eye.iol.is_some();
+    let (focused, focus_limit) = match focus {
+        None => (eye.clone(), eye::FocusLimit::Reached),
+        Some(_) => {
+            let f = eye::focus_within_range(&eye, focus, a.pupil_mm, a.wavelength_nm, limited)?;
+            (f.eye, f.limit)
+        }
     };
     let m = eye::measure(
         &focused.system()?,
@@ -460,6 +478,9 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
             coefficients: Vec<eye::measure::Coefficient>,
             power_d: f64,
             refraction: eye::Refraction,
+            focus_limit: eye::FocusLimit,
+            #[serde(flatten)]
+            physiology: &'a super::correction::Physiology,
             #[serde(flatten)]
             rest: &'a eye::Measurement,
         }
@@ -469,6 +490,8 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
                 coefficients: m.coefficient_list(),
                 power_d: m.power_d,
                 refraction: m.refraction,
+                focus_limit,
+                physiology: &physiology,
                 rest: &m,
             })?
         );
@@ -491,6 +514,20 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
             .sum::<f64>()
             .sqrt()
     );
+    if let Some(c) = &physiology.correction {
+        println!("through {c}");
+    }
+    if let Some(p) = physiology.iol_d {
+        println!("with a {p:.2} D IOL");
+    }
+    if focus_limit != eye::FocusLimit::Reached {
+        let at = if focus_limit == eye::FocusLimit::FarPoint {
+            "far"
+        } else {
+            "near"
+        };
+        println!("focus clamped at the {at} point (the eye cannot focus there)");
+    }
     println!("{:>3} {:>4} {:>12}", "n", "m", "µm");
     for c in m.coefficient_list().iter().skip(1) {
         println!("{:>3} {:>4} {:>12.5}", c.n, c.m, c.um);
@@ -501,6 +538,9 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
 fn run_draw(a: &DrawArgs) -> Result<()> {
     let f = eye_file::resolve(&a.eye)?;
     check_pupil(a.pupil_mm)?;
+    crate::limits::WAVELENGTH_NM
+        .check("--wavelength-nm", a.wavelength_nm)
+        .map_err(Error::input)?;
     let ext = a
         .output
         .extension()

@@ -22,6 +22,8 @@ pub struct KernelsArgs {
     /// The eye: a TOML eye file or a preset name.
     #[arg(long, value_name = "FILE|NAME")]
     pub eye: String,
+    #[command(flatten)]
+    pub correction: super::correction::CorrectionArgs,
     /// Object distances in dioptres: MIN..MAX:COUNT, uniform [default: 0.125..10.125:41].
     #[arg(long, value_name = "MIN..MAX:N")]
     pub objects: Option<String>,
@@ -184,7 +186,7 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         outputs.add("--plot", p, &["png"])?;
     }
     outputs.probe()?;
-    let eye = load_eye(&args.eye)?;
+    let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
     let mut axes = GridAxes::default();
     if let Some(text) = &args.wavelengths_nm {
         let wl = parse_list("wavelengths-nm", text)?;

@@ -7,6 +7,7 @@ use crate::Result;
 
 mod bench;
 mod compare;
+mod correction;
 mod devices;
 mod eye;
 mod eye_plot;
@@ -14,6 +15,7 @@ mod kernels;
 mod outputs;
 mod psf;
 mod raster;
+mod refract;
 mod render;
 mod sha256;
 mod video;

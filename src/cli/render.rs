@@ -111,9 +111,15 @@ pub struct RenderArgs {
     /// Pupil formula for luminance-driven pupils.
     #[arg(long, value_enum, default_value = "watson-yellott")]
     pub pupil_model: PupilModel,
-    /// Observer age (years) for the Watson–Yellott formula, which covers ages 20 to 83.
+    /// Observer age (years), 20 to 83: the Watson–Yellott pupil and Hofstetter's amplitude
+    /// of accommodation (unless the eye file or --accommodation-max-d sets one).
     #[arg(long, default_value_t = 30.0, value_parser = parse_age_years, allow_hyphen_values = true)]
     pub age: f64,
+    /// Which of Hofstetter's age–amplitude lines --age reads.
+    #[arg(long, value_enum, default_value = "mean")]
+    pub accommodation_line: crate::eye::age::HofstetterLine,
+    #[command(flatten)]
+    pub correction: super::correction::CorrectionArgs,
     /// Vertical field of view in degrees; required with --color (scenes use their camera's).
     #[arg(
         long,
@@ -313,7 +319,7 @@ pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
 }
 
 /// `--age`: a number of years within the range Watson & Yellott fitted (20 to 83).
-fn parse_age_years(text: &str) -> std::result::Result<f64, String> {
+pub(crate) fn parse_age_years(text: &str) -> std::result::Result<f64, String> {
     let age: f64 = text
         .trim()
         .parse()
@@ -447,10 +453,15 @@ struct Summary {
     depth_report: Option<crate::inputs::DepthReport>,
     /// The focus asked for (D; 0 = infinity).
     focus_d: f64,
-    /// Where the eye actually focuses (D): `focus_d`, or its far point when `focus_d` lies
-    /// beyond it (`focus_clamped`).
+    /// Where the eye actually focuses (D): `focus_d`, or its far (near) point when `focus_d`
+    /// lies beyond (nearer than) it (`focus_clamped`, `focus_limit`).
+    focus_reached_d: f64,
+    /// The same as `focus_reached_d` (the earlier name).
     focus_actual_d: f64,
     focus_clamped: bool,
+    focus_limit: crate::eye::FocusLimit,
+    #[serde(flatten)]
+    physiology: super::correction::Physiology,
     pupil_mm: f64,
     pupil_source: String,
     /// Things about the input a user should know (also printed on stderr).
@@ -493,7 +504,10 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             )));
         }
     }
-    let eye = load_eye(&args.eye)?;
+    let (eye, physiology) = args.correction.apply(
+        &load_eye(&args.eye)?,
+        Some((args.age, args.accommodation_line)),
+    )?;
     let ctx = Context::new(&cli.context_options())?;
     let input = load_input(cli, args, &ctx)?;
     for w in &input.warnings {
@@ -583,8 +597,11 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         depth: input.depth_source.clone(),
         depth_report: input.depth_report.clone(),
         focus_d,
+        focus_reached_d: focus.actual_d,
         focus_actual_d: focus.actual_d,
-        focus_clamped: focus.beyond_far_point,
+        focus_clamped: focus.clamped(),
+        focus_limit: focus.limit,
+        physiology,
         pupil_mm,
         pupil_source,
         warnings: input.warnings.clone(),
@@ -614,15 +631,26 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             "infinity".into()
         }
     };
-    let focus = if focus.beyond_far_point {
-        format!(
+    let focus = match focus.limit {
+        crate::eye::FocusLimit::Reached => distance(focus_d),
+        crate::eye::FocusLimit::FarPoint => format!(
             "{} (its far point; asked {}, beyond it)",
             distance(focus.actual_d),
             distance(focus_d)
-        )
-    } else {
-        distance(focus_d)
+        ),
+        crate::eye::FocusLimit::NearPoint => format!(
+            "{} (its near point, clamped; asked {}, nearer)",
+            distance(focus.actual_d),
+            distance(focus_d)
+        ),
     };
+    let through = summary
+        .physiology
+        .correction
+        .as_ref()
+        .map(|c| format!(" through {c}"))
+        .unwrap_or_default();
+    let focus = format!("{focus}{through}");
     println!(
         "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
         summary.output,

@@ -68,9 +68,16 @@ pub struct VideoArgs {
     /// Frame size (default: the scene's `resolution`).
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
-    /// Render every frame through this second eye as well, side by side and labelled.
-    #[arg(long, value_name = "NAME|FILE")]
+    /// Render every frame through this second eye as well, side by side and labelled;
+    /// `uncorrected` is the --eye without --correct/--iol-d.
+    #[arg(long, value_name = "NAME|FILE|uncorrected")]
     pub side_by_side: Option<String>,
+    #[command(flatten)]
+    pub correction: super::correction::CorrectionArgs,
+    /// Observer age (years), 20 to 83: the Watson–Yellott pupil and Hofstetter's mean
+    /// amplitude of accommodation (unless the eye file or --accommodation-max-d sets one).
+    #[arg(long, default_value_t = 30.0, value_parser = super::render::parse_age_years, allow_hyphen_values = true)]
+    pub age: f64,
     /// Fixed camera (the scene at t = 0); focus moves from NEAR to FAR metres, linearly in
     /// dioptres.
     #[arg(long, value_name = "NEAR..FAR")]
@@ -214,7 +221,7 @@ fn pupil_for(args: &VideoArgs, state: &FrameState<'_>, frame: &Frame, fov_y_deg:
     watson_yellott_mm(
         luminance,
         fov_y_deg * fov_y_deg * aspect,
-        30.0,
+        args.age,
         Viewing::OneEye,
     )
     .clamp(1.5, 8.0)
@@ -359,10 +366,14 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         Some(text) => parse_range(text, count).map_err(Error::input)?,
         None => (0, count),
     };
-    let mut eyes: Vec<(String, Eye)> = vec![(args.eye.clone(), load_eye_for("--eye", &args.eye)?)];
-    if let Some(spec) = &args.side_by_side {
-        eyes.push((spec.clone(), load_eye_for("--side-by-side", spec)?));
-    }
+    // The pupil model's age also sets the amplitude of accommodation, as in render.
+    let eyes = args.correction.labelled_eyes(
+        &args.eye,
+        load_eye_for("--eye", &args.eye)?,
+        args.side_by_side.as_deref(),
+        |spec| load_eye_for("--side-by-side", spec),
+        Some((args.age, crate::eye::age::HofstetterLine::Mean)),
+    )?;
     if args.output.exists() && !args.output.is_dir() {
         return Err(Error::file(
             &args.output,
@@ -412,6 +423,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             &options.reference_axes,
             &splat,
             &planning_frames(count),
+            &args.age,
         ]),
     };
     let removed = manifest::open(&args.output, &config, args.overwrite)?;

@@ -168,7 +168,7 @@ impl Measurer {
         let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
         let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
         let radius = pupil_mm / 2.0;
-        let launch = launcher(object_distance_m, radius, ep_z);
+        let launch = launcher(object_distance_m, radius, ep_z, first_z(sys))?;
 
         let mut chief = launch(0.0, 0.0);
         trace_range(sys, &n, &mut chief, 0..ns).map_err(|v| {
@@ -269,7 +269,7 @@ impl Measurer {
         let py = paraxial(sys, wavelength_nm, 90.0);
         let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
         let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
-        let launch = launcher(object_distance_m, pupil_mm / 2.0, ep_z);
+        let launch = launcher(object_distance_m, pupil_mm / 2.0, ep_z, first_z(sys))?;
         let mut chief = launch(0.0, 0.0);
         trace_range(sys, &n, &mut chief, 0..ns)
             .map_err(|v| EyeError::Invalid(format!("chief ray vignetted ({v:?})")))?;
@@ -318,12 +318,18 @@ fn check_inputs(
     pupil_mm: f64,
     object_distance_m: Option<f64>,
 ) -> Result<(), EyeError> {
-    crate::limits::WAVELENGTH_NM
-        .check("wavelength", wavelength_nm)
-        .map_err(EyeError::Invalid)?;
-    crate::limits::PUPIL_MM
-        .check("pupil diameter", pupil_mm)
-        .map_err(EyeError::Invalid)?;
+    // The optics' own domain (the commands and files accept the narrower ranges of
+    // `crate::limits`; tests trace a 0.5 mm pupil to compare with paraxial optics).
+    if !(wavelength_nm.is_finite() && (300.0..=1100.0).contains(&wavelength_nm)) {
+        return Err(EyeError::Invalid(format!(
+            "wavelength {wavelength_nm} nm is outside 300–1100 nm"
+        )));
+    }
+    if !(pupil_mm.is_finite() && pupil_mm > 0.0 && pupil_mm <= 10.0) {
+        return Err(EyeError::Invalid(format!(
+            "pupil diameter {pupil_mm} mm is outside (0, 10] mm"
+        )));
+    }
     if let Some(d) = object_distance_m {
         if !(d.is_finite() && d > 0.02) {
             return Err(EyeError::Invalid(format!(
@@ -334,33 +340,63 @@ fn check_inputs(
     Ok(())
 }
 
-/// Ray factory for normalised pupil coordinates (u, v) on the entrance pupil.
-fn launcher(object_distance_m: Option<f64>, radius_mm: f64, ep_z: f64) -> impl Fn(f64, f64) -> Ray {
-    move |u: f64, v: f64| match object_distance_m {
-        Some(d) => spherical_wave_ray(1000.0 * d, [radius_mm * u, radius_mm * v], ep_z),
+/// The frontmost vertex of the system (a spectacle lens lies before the cornea).
+fn first_z(sys: &OpticalSystem) -> f64 {
+    sys.surfaces
+        .iter()
+        .map(|s| s.vertex_z_mm)
+        .fold(0.0, f64::min)
+}
+
+/// Ray factory for normalised pupil coordinates (u, v) on the entrance pupil; a plane wave
+/// starts 5 mm before the first surface, and a point object must lie before it.
+fn launcher(
+    object_distance_m: Option<f64>,
+    radius_mm: f64,
+    ep_z: f64,
+    first_z_mm: f64,
+) -> Result<impl Fn(f64, f64) -> Ray, EyeError> {
+    if let Some(d) = object_distance_m {
+        if -1000.0 * d >= first_z_mm {
+            return Err(EyeError::Invalid(format!(
+                "an object {d} m from the cornea lies behind the lens {:.1} mm in front of it",
+                -first_z_mm
+            )));
+        }
+    }
+    let start_z = first_z_mm - 5.0;
+    // A point object nearer than 5 mm before the first surface: start halfway to it.
+    let point_start_z =
+        move |object_mm: f64| start_z.max(0.5 * (first_z_mm - object_mm)).min(first_z_mm);
+    Ok(move |u: f64, v: f64| match object_distance_m {
+        Some(d) => spherical_wave_ray(
+            1000.0 * d,
+            [radius_mm * u, radius_mm * v],
+            ep_z,
+            point_start_z(1000.0 * d),
+        ),
         None => Ray {
-            p: [radius_mm * u, radius_mm * v, -5.0],
+            p: [radius_mm * u, radius_mm * v, start_z],
             d: [0.0, 0.0, 1.0],
             opl_mm: 0.0,
         },
-    }
+    })
 }
 
 /// The ray from an on-axis point `object_mm` before the corneal vertex, aimed at `aim` on the
 /// entrance-pupil plane `ep_z`, started where it crosses the object's spherical wavefront
-/// through (0, 0, −5 mm), with optical path zero there (every start point is equally far from
-/// the object). Starting at the object itself would carry paths of ~10¹³ mm for a focus of
-/// 10⁻¹⁰ D, whose differences lose micrometres to rounding; the sag is written so that no
+/// through (0, 0, `start_z`), with optical path zero there (every start point is equally far
+/// from the object). Starting at the object itself would carry paths of ~10¹³ mm for a focus
+/// of 10⁻¹⁰ D, whose differences lose micrometres to rounding; the sag is written so that no
 /// large numbers cancel.
-fn spherical_wave_ray(object_mm: f64, aim: [f64; 2], ep_z: f64) -> Ray {
-    const START_Z: f64 = -5.0;
+fn spherical_wave_ray(object_mm: f64, aim: [f64; 2], ep_z: f64, start_z: f64) -> Ray {
     let axial = ep_z + object_mm;
     let h2 = aim[0] * aim[0] + aim[1] * aim[1];
     let s = (h2 + axial * axial).sqrt();
-    let radius = object_mm + START_Z;
+    let radius = object_mm + start_z;
     let sag = radius * h2 / (s * (s + axial));
     Ray {
-        p: [radius * aim[0] / s, radius * aim[1] / s, START_Z - sag],
+        p: [radius * aim[0] / s, radius * aim[1] / s, start_z - sag],
         d: [aim[0] / s, aim[1] / s, axial / s],
         opl_mm: 0.0,
     }

@@ -2,6 +2,8 @@
 //! exact ray tracing, paraxial optics, accommodation and aberration measurement.
 
 pub mod accommodate;
+pub mod age;
+pub mod correction;
 pub mod draw;
 pub mod estimate;
 pub mod file;
@@ -12,13 +14,14 @@ pub mod media;
 pub mod model;
 pub mod paraxial;
 pub mod presets;
+pub mod refract;
 pub mod show;
 pub mod surface;
 pub mod system;
 pub mod test_eyes;
 pub mod trace;
 
-pub use accommodate::{accommodate, Accommodation};
+pub use accommodate::{accommodate, focus_within_range, Accommodation, FocusLimit, Focused};
 pub use measure::{measure, Measurement, Measurer, Refraction};
 pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens};
 pub use paraxial::{paraxial, Paraxial};

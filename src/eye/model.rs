@@ -4,6 +4,7 @@
 //! (horizontal, vertical). The lens anterior vertex sits `aqueous_depth_mm` behind the
 //! posterior cornea and carries the iris.
 
+use super::correction::{Iol, Spectacle};
 use super::lens::{lens_geometry, LensGeometry};
 use super::media::Medium;
 use super::surface::Surface;
@@ -93,6 +94,16 @@ pub struct Eye {
     /// Posterior cornea vertex to anterior lens vertex.
     pub aqueous_depth_mm: f64,
     pub lens: Lens,
+    /// Amplitude of accommodation (D): how far the lens may accommodate from relaxed (see
+    /// `eye::age`). Absent = unlimited unless an age sets it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accommodation_max_d: Option<f64>,
+    /// A spectacle or contact lens in front of the cornea, traced with the eye.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub correction: Option<Spectacle>,
+    /// An intraocular lens in place of the crystalline lens (no accommodation).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub iol: Option<Iol>,
 }
 
 impl Default for Eye {
@@ -258,19 +269,56 @@ impl Eye {
             g.semi_diameter_mm,
         )
         .with_placement(l.decentration_mm, tilt, z_eq);
+        if let Some(a) = self.accommodation_max_d {
+            if !(a.is_finite() && (0.0..=super::age::MAX_AMPLITUDE_D).contains(&a)) {
+                return Err(EyeError::Invalid(format!(
+                    "accommodation_max_d {a} is outside 0 to {} D",
+                    super::age::MAX_AMPLITUDE_D
+                )));
+            }
+        }
+        let (mut surfaces, mut media) = match &self.iol {
+            None => (
+                vec![ant, post, lens_a, lens_p],
+                vec![
+                    Medium::Cornea,
+                    Medium::Aqueous,
+                    Medium::Lens,
+                    Medium::Vitreous,
+                ],
+            ),
+            Some(iol) => {
+                iol.validate()?;
+                (
+                    vec![ant, post, iol.surface(z_eq)],
+                    vec![Medium::Cornea, Medium::Aqueous, Medium::Vitreous],
+                )
+            }
+        };
+        let mut stop_index = 2;
+        if let Some(spec) = &self.correction {
+            spec.validate()?;
+            surfaces.insert(0, spec.surface());
+            media.insert(0, Medium::Air);
+            stop_index += 1;
+        }
         Ok(OpticalSystem {
-            surfaces: vec![ant, post, lens_a, lens_p],
-            media: vec![
-                Medium::Cornea,
-                Medium::Aqueous,
-                Medium::Lens,
-                Medium::Vitreous,
-            ],
-            stop_index: 2,
+            surfaces,
+            media,
+            stop_index,
             stop_z_mm: z_lens,
             retina_z_mm: self.axial_length_mm,
             lens_index_offset: 0.0,
         })
+    }
+
+    /// The eye alone: no spectacle or contact lens, no IOL (the natural lens back).
+    pub fn without_corrections(&self) -> Eye {
+        Eye {
+            correction: None,
+            iol: None,
+            ..self.clone()
+        }
     }
 
     /// Parses and validates an eye from TOML text: either the bare structure, or an eye file

@@ -73,7 +73,8 @@ pub fn paraxial(sys: &OpticalSystem, wavelength_nm: f64, meridian_deg: f64) -> P
     for i in 0..ns {
         let (c, z0) = meridian_curvature(sys, i, phi);
         z.push(sys.surfaces[i].vertex_z_mm + z0);
-        r.push(refraction((n[i + 1] - n[i]) * c));
+        let ideal = sys.surfaces[i].phase_power_along(phi);
+        r.push(refraction((n[i + 1] - n[i]) * c + ideal));
     }
     // Matrix from the reference plane just before surface `from` to just after surface `to`.
     let span = |from: usize, to: usize| -> M2 {

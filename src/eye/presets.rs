@@ -54,6 +54,9 @@ impl Eye {
                 decentration_mm: [0.0; 2],
                 tilt_deg: [0.0; 2],
             },
+            accommodation_max_d: None,
+            correction: None,
+            iol: None,
         }
     }
 
@@ -74,6 +77,9 @@ impl Eye {
                 decentration_mm: [0.0; 2],
                 tilt_deg: [0.0; 2],
             },
+            accommodation_max_d: None,
+            correction: None,
+            iol: None,
         }
     }
 

@@ -66,10 +66,18 @@ pub fn trace_range(
             return Err(Vignetting::Missed(i));
         }
         let hit = [pl[0] + t * dl[0], pl[1] + t * dl[1], pl[2] + t * dl[2]];
-        let dn =
-            refract(dl, normal, n[i], n[i + 1]).ok_or(Vignetting::TotalInternalReflection(i))?;
+        let (dn, phase_mm) = if s.has_phase() {
+            let d = s
+                .phase_refract(dl, hit[0], hit[1], n[i], n[i + 1])
+                .ok_or(Vignetting::TotalInternalReflection(i))?;
+            (d, s.phase_mm(hit[0], hit[1]).0)
+        } else {
+            let d = refract(dl, normal, n[i], n[i + 1])
+                .ok_or(Vignetting::TotalInternalReflection(i))?;
+            (d, 0.0)
+        };
         let (pg, dg) = s.to_global(hit, dn);
-        ray.opl_mm += n[i] * t;
+        ray.opl_mm += n[i] * t + phase_mm;
         ray.p = pg;
         ray.d = dg;
     }

@@ -25,7 +25,7 @@
 //! at the object distance.
 
 use super::axes::KernelSettings;
-use crate::eye::{accommodate, measure, Eye};
+use crate::eye::{focus_within_range, measure, Eye, FocusLimit};
 use crate::optics::beta::beta_from_alpha;
 use crate::optics::psf::{defocus_f_from_c20, Pupil};
 use crate::optics::zernike::{order_for_len, wavefront_gradient};
@@ -164,6 +164,8 @@ pub struct ColumnOptics {
     pub lens_diameter_mm: f64,
     /// The focus lies beyond the eye's far point: the relaxed lens was kept.
     pub beyond_far_point: bool,
+    /// Whether the focus was reached, or clamped at the far or the near point.
+    pub focus_limit: FocusLimit,
     pub channels: [ChannelOptics; 3],
 }
 
@@ -183,17 +185,20 @@ impl ColumnOptics {
         settings: &KernelSettings,
     ) -> Result<ColumnOptics> {
         let distance = distance_of(focus_d);
-        let acc = accommodate(eye, distance, pupil_mm, settings.accommodation_nm).map_err(|e| {
+        let f = focus_within_range(
+            eye,
+            distance,
+            pupil_mm,
+            settings.accommodation_nm,
+            settings.far_point_limit,
+        )
+        .map_err(|e| {
             Error::input(format!(
                 "cannot focus the eye at focus-d {focus_d} D with pupils-mm {pupil_mm}: {e}"
             ))
         })?;
-        let (focused, beyond) =
-            if settings.far_point_limit && acc.diameter_mm > eye.lens.diameter_mm {
-                (eye.clone(), true)
-            } else {
-                (acc.eye, false)
-            };
+        let (focused, focus_limit) = (f.eye, f.limit);
+        let beyond = focus_limit == FocusLimit::FarPoint;
         let sys = focused.system()?;
         let mut channels = Vec::with_capacity(3);
         for wavelength_nm in wavelengths_nm {
@@ -227,6 +232,7 @@ impl ColumnOptics {
             focus_d,
             lens_diameter_mm: focused.lens.diameter_mm,
             beyond_far_point: beyond,
+            focus_limit,
             channels,
         })
     }

@@ -1,9 +1,9 @@
 //! Where the eye focuses: depth → vergence, distances too far to matter, and the far point
 //! of an eye that cannot relax enough.
 
-use crate::eye::accommodate::accommodate;
 use crate::eye::measure::Measurer;
 use crate::eye::Eye;
+use crate::eye::{focus_within_range, FocusLimit};
 use crate::optics::zernike::osa_index;
 use crate::psf::axes::{GridAxes, KernelSettings};
 use crate::{Error, Result};
@@ -82,11 +82,19 @@ pub fn normalised_focus_d(focus_d: f64) -> f64 {
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct FocusOutcome {
     pub requested_d: f64,
-    /// Where the eye actually focuses (D): the request, or the far point when the request
-    /// lies beyond it.
+    /// Where the eye actually focuses (D): the request, or the far (near) point when the
+    /// request lies beyond (nearer than) it.
     pub actual_d: f64,
     /// The request lies beyond the eye's far point: the eye stays relaxed.
     pub beyond_far_point: bool,
+    /// Reached, or clamped at the far or the near point.
+    pub limit: FocusLimit,
+}
+
+impl FocusOutcome {
+    pub fn clamped(&self) -> bool {
+        self.limit != FocusLimit::Reached
+    }
 }
 
 /// Object distance (m) of a vergence, `None` for infinity.
@@ -95,9 +103,10 @@ fn distance_of(focus_d: f64) -> Option<f64> {
 }
 
 /// Checks that `eye` can focus at `focus_d` with `pupil_mm` and, where the request lies
-/// beyond the far point (a myopic eye asked to focus far), finds the far point the relaxed
-/// eye actually focuses at — the same criterion (c(2,0) = 0 at the accommodation wavelength)
-/// the kernels use. `what` names the options that set the focus, for errors.
+/// beyond the far point (a myopic eye asked to focus far) or nearer than the near point (an
+/// eye with too little accommodation, or an IOL), finds where the limiting lens focuses — the
+/// same criterion (c(2,0) = 0 at the accommodation wavelength) the kernels use. `what` names
+/// the options that set the focus, for errors.
 pub fn effective_focus(
     eye: &Eye,
     focus_d: f64,
@@ -114,32 +123,35 @@ pub fn effective_focus(
             "{what}: the eye cannot focus at {at} with a {pupil_mm} mm pupil (--pupil-mm): {e}"
         ))
     };
-    let acc = accommodate(
+    let f = focus_within_range(
         eye,
         distance_of(focus_d),
         pupil_mm,
         settings.accommodation_nm,
+        settings.far_point_limit,
     )
     .map_err(|e| fail(&e))?;
-    let beyond = settings.far_point_limit && acc.diameter_mm > eye.lens.diameter_mm;
-    if !beyond {
+    if f.limit == FocusLimit::Reached {
         return Ok(FocusOutcome {
             requested_d: focus_d,
             actual_d: focus_d,
             beyond_far_point: false,
+            limit: f.limit,
         });
     }
     let actual_d =
-        far_point_d(eye, pupil_mm, settings.accommodation_nm, focus_d).map_err(|e| fail(&e))?;
+        far_point_d(&f.eye, pupil_mm, settings.accommodation_nm, focus_d).map_err(|e| fail(&e))?;
     Ok(FocusOutcome {
         requested_d: focus_d,
         actual_d,
-        beyond_far_point: true,
+        beyond_far_point: f.limit == FocusLimit::FarPoint,
+        limit: f.limit,
     })
 }
 
-/// The vergence (D) at which the relaxed `eye` has no Zernike defocus, found by the secant
-/// method from `start_d` (c(2,0) is close to linear in the object vergence).
+/// The vergence (D) at which `eye` (as it is, no further accommodation) has no Zernike
+/// defocus, found by the secant method from `start_d` (c(2,0) is close to linear in the object
+/// vergence); 0 where that point lies beyond infinity.
 fn far_point_d(eye: &Eye, pupil_mm: f64, wavelength_nm: f64, start_d: f64) -> Result<f64> {
     let sys = eye.system()?;
     let meas = Measurer::new(4, 6, 16);
@@ -160,9 +172,14 @@ fn far_point_d(eye: &Eye, pupil_mm: f64, wavelength_nm: f64, start_d: f64) -> Re
         v1 = v2;
         g1 = c20(v1)?;
     }
+    // c(2,0) < 0 at vergence 0: even a distant object is focused behind the retina's
+    // conjugate, so the eye's focus lies beyond infinity.
+    if v1 == 0.0 && g1 < 0.0 {
+        return Ok(0.0);
+    }
     if g1.abs() > 1e-4 {
         return Err(Error::input(format!(
-            "the relaxed eye's far point was not found (c(2,0) = {g1:.2e} µm at {v1:.3} D)"
+            "the eye's focus was not found (c(2,0) = {g1:.2e} µm at {v1:.3} D)"
         )));
     }
     Ok(v1)

@@ -1,0 +1,226 @@
+//! The options that put a correction in front of the eye (or an IOL in it) and limit its
+//! accommodation, shared by render, video, compare, kernels and `eye measure`. Each value is
+//! range-checked where clap parses it, so a bad one is a one-line error naming the option.
+
+use crate::eye::age::{hofstetter_amplitude_d, HofstetterLine, MAX_AMPLITUDE_D};
+use crate::eye::correction::{
+    emmetropic_iol_power_d, parse_rx, Iol, Spectacle, DEFAULT_VERTEX_MM, IOL_RANGE_D,
+    VERTEX_RANGE_MM,
+};
+use crate::eye::Eye;
+use crate::{Error, Result};
+
+/// Pupil and wavelength at which `--iol-d auto` makes the eye emmetropic: a photopic pupil
+/// at the accommodation wavelength.
+pub const AUTO_IOL_PUPIL_MM: f64 = 3.0;
+pub const AUTO_IOL_WAVELENGTH_NM: f64 = 549.0;
+
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct CorrectionArgs {
+    /// Spectacle lens in front of the eye, "S C x A": sphere and cylinder in dioptres
+    /// (sphere -25 to 25, cylinder -10 to 10; minus-cylinder form, a plus cylinder is
+    /// transposed) and axis 1 to 180 degrees. It is traced with the eye (kernels, focus,
+    /// measurement), not applied to the image.
+    #[arg(long, value_name = "S C x A", value_parser = parse_correct, allow_hyphen_values = true)]
+    pub correct: Option<Spectacle>,
+    /// Vertex distance of --correct, lens to cornea, in mm (0 to 16; default 12).
+    #[arg(long, value_name = "MM", value_parser = parse_vertex_mm, requires = "correct", allow_hyphen_values = true)]
+    pub vertex_mm: Option<f64>,
+    /// --correct is a contact lens (vertex distance 0).
+    #[arg(long, requires = "correct", conflicts_with = "vertex_mm")]
+    pub correct_contact: bool,
+    /// Monofocal intraocular lens in place of the crystalline lens: its power in dioptres
+    /// (-10 to 40), or `auto` for the power that makes the eye emmetropic (3 mm pupil,
+    /// 549 nm). An IOL does not accommodate.
+    #[arg(long, value_name = "D|auto", value_parser = parse_iol, allow_hyphen_values = true)]
+    pub iol_d: Option<IolPower>,
+    /// Amplitude of accommodation in dioptres (0 to 20), instead of the eye file's
+    /// accommodation_max_d or the age model's.
+    #[arg(long, value_name = "D", value_parser = parse_amplitude_d, allow_hyphen_values = true)]
+    pub accommodation_max_d: Option<f64>,
+}
+
+/// `--iol-d`: a power, or the emmetropic one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum IolPower {
+    Dioptres(f64),
+    Auto,
+}
+
+fn number(text: &str) -> std::result::Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| format!("{text:?} is not a number"))
+}
+
+fn range(v: f64, (lo, hi): (f64, f64), unit: &str) -> std::result::Result<f64, String> {
+    if v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside {lo} to {hi} {unit}"))
+    }
+}
+
+fn parse_correct(text: &str) -> std::result::Result<Spectacle, String> {
+    parse_rx(text, DEFAULT_VERTEX_MM)
+}
+
+fn parse_vertex_mm(text: &str) -> std::result::Result<f64, String> {
+    range(number(text)?, VERTEX_RANGE_MM, "mm")
+}
+
+fn parse_iol(text: &str) -> std::result::Result<IolPower, String> {
+    if text.trim().eq_ignore_ascii_case("auto") {
+        return Ok(IolPower::Auto);
+    }
+    let v = number(text).map_err(|e| format!("{e}; a power in D or auto"))?;
+    range(v, IOL_RANGE_D, "D").map(IolPower::Dioptres)
+}
+
+pub(crate) fn parse_amplitude_d(text: &str) -> std::result::Result<f64, String> {
+    range(number(text)?, (0.0, MAX_AMPLITUDE_D), "D")
+}
+
+/// Where the amplitude of accommodation came from, for reports.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Physiology {
+    /// Amplitude of accommodation (D); null = unlimited.
+    pub accommodation_max_d: Option<f64>,
+    pub accommodation_source: String,
+    /// The correction in `--correct` form, with its vertex distance.
+    pub correction: Option<String>,
+    pub iol_d: Option<f64>,
+}
+
+impl CorrectionArgs {
+    /// Whether any correction option was given.
+    pub fn corrects(&self) -> bool {
+        self.correct.is_some() || self.iol_d.is_some()
+    }
+
+    /// `eye` with the correction, the IOL and the amplitude of accommodation these options
+    /// (and `age`, when the command has one) give it.
+    pub fn apply(
+        &self,
+        eye: &Eye,
+        age: Option<(f64, HofstetterLine)>,
+    ) -> Result<(Eye, Physiology)> {
+        let mut e = eye.clone();
+        let source = if let Some(a) = self.accommodation_max_d {
+            e.accommodation_max_d = Some(a);
+            "--accommodation-max-d".to_string()
+        } else if e.accommodation_max_d.is_some() {
+            "the eye file's accommodation_max_d".to_string()
+        } else if let Some((years, line)) = age {
+            e.accommodation_max_d = Some(hofstetter_amplitude_d(years, line));
+            format!(
+                "Hofstetter's {} line at {years} years",
+                format!("{line:?}").to_lowercase()
+            )
+        } else {
+            "unlimited".to_string()
+        };
+        if let Some(mut s) = self.correct {
+            s.vertex_mm = if self.correct_contact {
+                0.0
+            } else {
+                self.vertex_mm.unwrap_or(DEFAULT_VERTEX_MM)
+            };
+            e.correction = Some(s);
+        }
+        if let Some(p) = self.iol_d {
+            let power_d = match p {
+                IolPower::Dioptres(d) => d,
+                IolPower::Auto => {
+                    emmetropic_iol_power_d(&e, AUTO_IOL_PUPIL_MM, AUTO_IOL_WAVELENGTH_NM)
+                        .map_err(|err| Error::input(format!("--iol-d auto: {err}")))?
+                }
+            };
+            e.iol = Some(Iol { power_d });
+        }
+        e.validate()
+            .map_err(|err| Error::input(format!("--correct/--iol-d: {err}")))?;
+        let physiology = Physiology {
+            accommodation_max_d: if e.iol.is_some() {
+                Some(0.0)
+            } else {
+                e.accommodation_max_d
+            },
+            accommodation_source: if e.iol.is_some() {
+                "an IOL does not accommodate".into()
+            } else {
+                source
+            },
+            correction: e.correction.map(|s| describe(&s)),
+            iol_d: e.iol.map(|i| i.power_d),
+        };
+        Ok((e, physiology))
+    }
+}
+
+impl CorrectionArgs {
+    /// The eyes of a side-by-side export, labelled: `--eye` with these options, and the
+    /// `--side-by-side` eye (`uncorrected`: the same eye without the correction) with only the
+    /// amplitude options.
+    pub fn labelled_eyes(
+        &self,
+        spec: &str,
+        eye: Eye,
+        side_by_side: Option<&str>,
+        load: impl Fn(&str) -> Result<Eye>,
+        age: Option<(f64, HofstetterLine)>,
+    ) -> Result<Vec<(String, Eye)>> {
+        let (corrected, physiology) = self.apply(&eye, age)?;
+        // Labels fit a panel: the prescription alone when the other panel is the same eye.
+        let same = side_by_side.is_some_and(|o| o.eq_ignore_ascii_case("uncorrected"));
+        let what = match (&e_notation(&corrected), physiology.iol_d) {
+            (Some(c), _) => Some(c.clone()),
+            (None, Some(p)) => Some(format!("IOL {p:.1} D")),
+            _ => None,
+        };
+        let label = match (what, same) {
+            (Some(w), true) => w,
+            (Some(w), false) => format!("{spec} {w}"),
+            (None, _) => spec.to_string(),
+        };
+        let mut eyes = vec![(label, corrected)];
+        if let Some(other) = side_by_side {
+            let (e, label) = if other.eq_ignore_ascii_case("uncorrected") {
+                if !self.corrects() {
+                    return Err(Error::input(
+                        "--side-by-side uncorrected compares with --correct or --iol-d; neither is given",
+                    ));
+                }
+                (eye, "uncorrected".to_string())
+            } else {
+                (load(other)?, other.to_string())
+            };
+            let plain = CorrectionArgs {
+                accommodation_max_d: self.accommodation_max_d,
+                ..Default::default()
+            };
+            eyes.push((label, plain.apply(&e, age)?.0));
+        }
+        Ok(eyes)
+    }
+}
+
+fn e_notation(eye: &Eye) -> Option<String> {
+    eye.correction.map(|s| s.notation())
+}
+
+/// `-6.50 +0.00 x 180 at 12 mm` (or `as a contact lens`).
+pub fn describe(s: &Spectacle) -> String {
+    if s.vertex_mm == 0.0 {
+        format!("{} (contact lens)", s.notation())
+    } else {
+        format!("{} at {} mm", s.notation(), s.vertex_mm)
+    }
+}
+
+/// Checks a vertex distance given outside `CorrectionArgs` (`eye refract`).
+pub(crate) fn parse_vertex_option(text: &str) -> std::result::Result<f64, String> {
+    parse_vertex_mm(text)
+}

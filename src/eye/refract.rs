@@ -1,0 +1,147 @@
+//! Objective refraction: the spectacle (or contact) lens that best corrects an eye, from its
+//! traced wavefront.
+//!
+//! "Best" is the minimum-RMS criterion the rest of ocular uses: through the lens, the relaxed
+//! eye looking at a distant object has no Zernike defocus and no second-order astigmatism over
+//! the pupil. The first estimate carries the eye's power vector at its entrance pupil to the
+//! spectacle plane meridian by meridian (F = K/(1 + dK), d from the lens to the entrance
+//! pupil); then the lens is refined by measuring through it (the lens changes the entrance
+//! pupil and how the eye's higher-order aberrations enter the second-order terms) until the
+//! residual is below 1e-4 D.
+
+use super::correction::{normalised_axis_deg, Spectacle};
+use super::measure::{Measurer, Refraction};
+use super::model::{Eye, EyeError};
+use serde::Serialize;
+
+/// A prescription at the spectacle plane, and how well it corrects.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpectacleRefraction {
+    pub sphere_d: f64,
+    /// ≤ 0 (minus-cylinder form).
+    pub cylinder_d: f64,
+    /// 1–180°.
+    pub axis_deg: f64,
+    pub vertex_mm: f64,
+    pub pupil_mm: f64,
+    pub wavelength_nm: f64,
+    /// The uncorrected eye's refraction at its entrance pupil (power vector, D).
+    pub eye_refraction: Refraction,
+    pub eye_entrance_pupil_z_mm: f64,
+    /// Length of the power vector (M, J0, J45) left through the lens (D).
+    pub residual_d: f64,
+    pub iterations: usize,
+}
+
+impl SpectacleRefraction {
+    pub fn spectacle(&self) -> Result<Spectacle, EyeError> {
+        Spectacle::new(
+            self.sphere_d,
+            self.cylinder_d,
+            self.axis_deg,
+            self.vertex_mm,
+        )
+    }
+}
+
+/// Sphere, minus cylinder and axis (1–180°) of a power vector.
+pub fn power_vector_to_rx(m: f64, j0: f64, j45: f64) -> (f64, f64, f64) {
+    let r = j0.hypot(j45);
+    let cylinder = -2.0 * r;
+    let axis = if r < 1e-12 {
+        180.0
+    } else {
+        normalised_axis_deg(0.5 * j45.atan2(j0).to_degrees())
+    };
+    (m - cylinder / 2.0, cylinder, axis)
+}
+
+/// The power vector (M, J0, J45) of sphere, cylinder and axis (Thibos et al. 1997).
+pub fn rx_to_power_vector(sphere_d: f64, cylinder_d: f64, axis_deg: f64) -> [f64; 3] {
+    let a = 2.0 * axis_deg.to_radians();
+    [
+        sphere_d + cylinder_d / 2.0,
+        -cylinder_d / 2.0 * a.cos(),
+        -cylinder_d / 2.0 * a.sin(),
+    ]
+}
+
+fn measure_far(
+    eye: &Eye,
+    pupil_mm: f64,
+    wavelength_nm: f64,
+) -> Result<(Refraction, f64), EyeError> {
+    let m = Measurer::standard().measure(&eye.system()?, wavelength_nm, pupil_mm, None)?;
+    Ok((m.refraction, m.entrance_pupil_z_mm))
+}
+
+/// The lens at `vertex_mm` in front of the cornea that corrects `eye` (its own spectacle
+/// removed; an IOL kept) for a distant object over a `pupil_mm` entrance pupil at
+/// `wavelength_nm`.
+pub fn refract(
+    eye: &Eye,
+    pupil_mm: f64,
+    vertex_mm: f64,
+    wavelength_nm: f64,
+) -> Result<SpectacleRefraction, EyeError> {
+    let mut bare = eye.clone();
+    bare.correction = None;
+    let (r0, ep_z) = measure_far(&bare, pupil_mm, wavelength_nm)?;
+    let d_m = (vertex_mm + ep_z) * 1e-3;
+    let (s, c, a) = power_vector_to_rx(r0.m, r0.j0, r0.j45);
+    let carry = |k: f64| k / (1.0 + d_m * k);
+    let (s1, s2) = (carry(s), carry(s + c));
+    let mut pv = rx_to_power_vector(s1, s2 - s1, a);
+    let mut corrected = bare.clone();
+    let mut residual = f64::INFINITY;
+    let mut iterations = 0;
+    while iterations < 12 {
+        let (s, c, a) = power_vector_to_rx(pv[0], pv[1], pv[2]);
+        corrected.correction = Some(Spectacle::new(s, c, a, vertex_mm)?);
+        let (r, _) = measure_far(&corrected, pupil_mm, wavelength_nm)?;
+        iterations += 1;
+        residual = (r.m * r.m + r.j0 * r.j0 + r.j45 * r.j45).sqrt();
+        if residual < 1e-4 {
+            break;
+        }
+        // A lens change dF moves the vergence at the pupil by dF/(1 − dF)².
+        let gain = (1.0 - d_m * pv[0]).powi(2);
+        pv[0] += r.m * gain;
+        pv[1] += r.j0 * gain;
+        pv[2] += r.j45 * gain;
+    }
+    let (sphere_d, cylinder_d, axis_deg) = power_vector_to_rx(pv[0], pv[1], pv[2]);
+    Ok(SpectacleRefraction {
+        sphere_d,
+        cylinder_d,
+        axis_deg,
+        vertex_mm,
+        pupil_mm,
+        wavelength_nm,
+        eye_refraction: r0,
+        eye_entrance_pupil_z_mm: ep_z,
+        residual_d: residual,
+        iterations,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn power_vectors_round_trip_through_minus_cylinder_form() {
+        for (s, c, a) in [(-2.0, -1.5, 30.0), (1.0, -0.25, 180.0), (-6.0, 0.0, 180.0)] {
+            let pv = rx_to_power_vector(s, c, a);
+            let (s2, c2, a2) = power_vector_to_rx(pv[0], pv[1], pv[2]);
+            assert!(
+                (s - s2).abs() < 1e-12 && (c - c2).abs() < 1e-12,
+                "{s} {c} {a}"
+            );
+            assert!((a - a2).abs() < 1e-9, "{a} vs {a2}");
+        }
+        // J0 = −(C/2)·cos 2A: a −1 D cylinder at 90° has J0 = −0.5 D.
+        let pv = rx_to_power_vector(0.0, -1.0, 90.0);
+        assert!((pv[1] + 0.5).abs() < 1e-12);
+    }
+}
