@@ -4,6 +4,7 @@
 pub mod accommodate;
 pub mod draw;
 pub mod estimate;
+pub mod field;
 pub mod file;
 pub mod fit;
 pub mod lens;
@@ -20,7 +21,7 @@ pub mod trace;
 
 pub use accommodate::{accommodate, Accommodation};
 pub use measure::{measure, Measurement, Measurer, Refraction};
-pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens};
+pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens, Retina};
 pub use paraxial::{paraxial, Paraxial};
 pub use presets::navarro_accommodated;
 pub use system::OpticalSystem;

@@ -93,6 +93,48 @@ pub struct Eye {
     /// Posterior cornea vertex to anterior lens vertex.
     pub aqueous_depth_mm: f64,
     pub lens: Lens,
+    /// Shape of the image surface. Files without it get the wide-angle retina (a sphere of
+    /// radius 12 mm, Escudero-Sanz & Navarro 1999); on axis the shape changes nothing.
+    #[serde(default, skip_serializing_if = "Retina::is_default")]
+    pub retina: Retina,
+}
+
+/// The image surface: its vertex lies on the axis at `axial_length_mm`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
+pub enum Retina {
+    /// The plane z = axial length (a paraxial schematic eye's image plane).
+    Plane,
+    /// A sphere concave towards the light, centred on the axis `radius_mm` in front of the
+    /// retinal vertex.
+    Sphere { radius_mm: f64 },
+}
+
+/// Retinal radius of the wide-angle schematic eye (Escudero-Sanz & Navarro 1999), mm.
+pub const WIDE_ANGLE_RETINA_RADIUS_MM: f64 = 12.0;
+/// Accepted retinal radii (mm): human retinas lie well inside; flatter is `shape = "plane"`.
+pub const RETINA_RADIUS_RANGE_MM: (f64, f64) = (8.0, 1000.0);
+
+impl Default for Retina {
+    fn default() -> Self {
+        Retina::Sphere {
+            radius_mm: WIDE_ANGLE_RETINA_RADIUS_MM,
+        }
+    }
+}
+
+impl Retina {
+    pub fn is_default(&self) -> bool {
+        *self == Retina::default()
+    }
+
+    /// Radius of curvature (mm); infinite for the plane.
+    pub fn radius_mm(&self) -> f64 {
+        match *self {
+            Retina::Plane => f64::INFINITY,
+            Retina::Sphere { radius_mm } => radius_mm,
+        }
+    }
 }
 
 impl Default for Eye {
@@ -196,6 +238,15 @@ impl Eye {
                 }
             }
         }
+        if let Retina::Sphere { radius_mm } = self.retina {
+            let (lo, hi) = RETINA_RADIUS_RANGE_MM;
+            if !(radius_mm.is_finite() && (lo..=hi).contains(&radius_mm)) {
+                return Err(EyeError::Invalid(format!(
+                    "retina.radius_mm must lie in {lo}–{hi} mm (shape = \"plane\" for a flat \
+                     retina), got {radius_mm}"
+                )));
+            }
+        }
         if self.lens.tilt_deg.iter().any(|t| t.abs() >= 45.0) {
             return Err(EyeError::Invalid(format!(
                 "lens.tilt_deg must stay within ±45°, got {:?}",
@@ -269,6 +320,7 @@ impl Eye {
             stop_index: 2,
             stop_z_mm: z_lens,
             retina_z_mm: self.axial_length_mm,
+            retina_radius_mm: self.retina.radius_mm(),
             lens_index_offset: 0.0,
         })
     }
