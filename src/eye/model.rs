@@ -101,7 +101,7 @@ pub struct Eye {
 
 /// The image surface: its vertex lies on the axis at `axial_length_mm`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
+#[serde(try_from = "RetinaTable", into = "RetinaTable")]
 pub enum Retina {
     /// The plane z = axial length (a paraxial schematic eye's image plane).
     Plane,
@@ -114,6 +114,46 @@ pub enum Retina {
 pub const WIDE_ANGLE_RETINA_RADIUS_MM: f64 = 12.0;
 /// Accepted retinal radii (mm): human retinas lie well inside; flatter is `shape = "plane"`.
 pub const RETINA_RADIUS_RANGE_MM: (f64, f64) = (8.0, 1000.0);
+
+/// The `[retina]` table as written: `shape = "plane"`, or `shape = "sphere"` with
+/// `radius_mm`.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RetinaTable {
+    shape: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    radius_mm: Option<f64>,
+}
+
+impl TryFrom<RetinaTable> for Retina {
+    type Error = String;
+    fn try_from(t: RetinaTable) -> Result<Self, String> {
+        match (t.shape.as_str(), t.radius_mm) {
+            ("plane", None) => Ok(Retina::Plane),
+            ("sphere", Some(radius_mm)) => Ok(Retina::Sphere { radius_mm }),
+            ("plane", Some(_)) => Err("retina: a plane has no radius_mm".into()),
+            ("sphere", None) => Err("retina: a sphere needs radius_mm".into()),
+            (other, _) => Err(format!(
+                "retina.shape {other:?} is not allowed; use \"sphere\" or \"plane\""
+            )),
+        }
+    }
+}
+
+impl From<Retina> for RetinaTable {
+    fn from(r: Retina) -> Self {
+        match r {
+            Retina::Plane => RetinaTable {
+                shape: "plane".into(),
+                radius_mm: None,
+            },
+            Retina::Sphere { radius_mm } => RetinaTable {
+                shape: "sphere".into(),
+                radius_mm: Some(radius_mm),
+            },
+        }
+    }
+}
 
 impl Default for Retina {
     fn default() -> Self {

@@ -1,0 +1,101 @@
+//! Off axis at the boundary: `eye measure --field-deg` (JSON like on axis, plus the pupil it
+//! used), its range checks, and the retina in eye files (old files load with the wide-angle
+//! retina, a plane is accepted, bad radii and unknown shapes are refused).
+
+use ocular::eye::{Eye, Retina};
+use std::process::{Command, Output};
+
+fn ocular(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ocular"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn refused(out: &Output, word: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(err.contains(word), "expected {word:?} in {err}");
+}
+
+fn measure_json(field: &str) -> serde_json::Value {
+    let out = ocular(&[
+        "eye",
+        "measure",
+        "navarro-wide",
+        "--pupil-mm",
+        "4",
+        "--wavelength-nm",
+        "555",
+        "--field-deg",
+        field,
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn measure_off_axis_prints_the_on_axis_json_and_its_pupil() {
+    let on = measure_json("0,0");
+    let off = measure_json("-30,0");
+    for key in ["coefficients", "refraction", "coefficients_um", "power_d", "rms_um"] {
+        assert!(off.get(key).is_some(), "{key} missing");
+    }
+    let j0 = off["refraction"]["j0"].as_f64().unwrap();
+    assert!(j0 < -0.5, "30° horizontally: J0 {j0}");
+    assert!(on["refraction"]["j0"].as_f64().unwrap().abs() < 1e-6);
+    let axes = off["field"]["semi_axes_mm"].as_array().unwrap();
+    let (t, s) = (axes[0].as_f64().unwrap(), axes[1].as_f64().unwrap());
+    // Foreshortened tangentially (≈ cos 30° times a little magnification), not sagittally.
+    assert!(t < 0.95 * s && t > 0.8 * s, "ellipse {t} × {s}");
+    // A vertical field turns the astigmatism's axis: J0 changes sign.
+    let up = measure_json("0,30");
+    assert!((up["refraction"]["j0"].as_f64().unwrap() + j0).abs() < 1e-6);
+}
+
+#[test]
+fn field_option_is_range_checked() {
+    for bad in ["61,0", "0,-70", "55,55", "nan,0", "10", "a,b", "1,2,3"] {
+        let out = ocular(&[
+            "eye",
+            "measure",
+            "navarro-wide",
+            "--pupil-mm",
+            "4",
+            "--wavelength-nm",
+            "555",
+            "--field-deg",
+            bad,
+        ]);
+        refused(&out, "--field-deg");
+    }
+}
+
+#[test]
+fn eye_files_carry_a_retina_shape() {
+    let old = Eye::navarro().to_toml_string();
+    assert!(!old.contains("retina"), "the default retina is not written");
+    assert_eq!(
+        Eye::from_toml_str(&old).unwrap().retina,
+        Retina::Sphere { radius_mm: 12.0 }
+    );
+    let plane = format!("{old}\n[retina]\nshape = \"plane\"\n");
+    assert_eq!(Eye::from_toml_str(&plane).unwrap().retina, Retina::Plane);
+    let sphere = format!("{old}\n[retina]\nshape = \"sphere\"\nradius_mm = 11.0\n");
+    let e = Eye::from_toml_str(&sphere).unwrap();
+    assert_eq!(e.retina, Retina::Sphere { radius_mm: 11.0 });
+    assert!(Eye::from_toml_str(&e.to_toml_string()).unwrap() == e);
+    let small = format!("{old}\n[retina]\nshape = \"sphere\"\nradius_mm = 2.0\n");
+    let err = Eye::from_toml_str(&small).unwrap_err().to_string();
+    assert!(err.contains("retina.radius_mm"), "{err}");
+    let odd = format!("{old}\n[retina]\nshape = \"cone\"\n");
+    assert!(Eye::from_toml_str(&odd).is_err());
+    let extra = format!("{old}\n[retina]\nshape = \"plane\"\nradius_mm = 3.0\n");
+    assert!(Eye::from_toml_str(&extra).is_err());
+    // The wide-angle preset: 23.9203 mm long, the 12 mm sphere.
+    let w = Eye::preset("navarro-wide").unwrap();
+    assert!((w.axial_length_mm - 23.9203).abs() < 1e-9);
+    assert_eq!(w.retina, Retina::Sphere { radius_mm: 12.0 });
+}
