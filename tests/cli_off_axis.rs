@@ -99,3 +99,83 @@ fn eye_files_carry_a_retina_shape() {
     assert!((w.axial_length_mm - 23.9203).abs() < 1e-9);
     assert_eq!(w.retina, Retina::Sphere { radius_mm: 12.0 });
 }
+
+fn kernels(dir: &std::path::Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "kernels",
+        "--eye",
+        "navarro-wide",
+        "--objects",
+        "0..2:3",
+        "--focus-d",
+        "0",
+        "--pupils-mm",
+        "4",
+        "--fov-y",
+        "40",
+        "--height",
+        "180",
+    ];
+    args.extend_from_slice(extra);
+    let cache = dir.join("cache");
+    let cache = cache.to_str().unwrap().to_string();
+    if !extra.contains(&"--no-cache") {
+        args.extend_from_slice(&["--cache", &cache]);
+    }
+    ocular(&args)
+}
+
+/// Grids over the field: an index and one grid per direction, each cached on its own (a
+/// second run computes nothing); the centre is the on-axis grid, bit for bit; off axis the
+/// in-focus kernel is larger (oblique astigmatism and coma).
+#[test]
+fn kernels_over_the_field_are_written_and_cached_per_direction() {
+    use ocular::psf::cache::read_grid;
+    let dir = std::env::temp_dir().join(format!("ocular-off-axis-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let index = dir.join("field.toml");
+    let out = kernels(
+        &dir,
+        &["--field-deg", "-30..30:3,0..0:1", "-o", index.to_str().unwrap()],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&index).unwrap();
+    assert_eq!(text.matches("[[node]]").count(), 3);
+    assert_eq!(text.matches("cached = false").count(), 3);
+    let again = kernels(
+        &dir,
+        &["--field-deg", "-30..30:3,0..0:1", "-o", index.to_str().unwrap()],
+    );
+    assert!(again.status.success());
+    let text = std::fs::read_to_string(&index).unwrap();
+    assert_eq!(text.matches("cached = true").count(), 3, "{text}");
+    let plain = dir.join("plain.bin");
+    assert!(kernels(&dir, &["--no-cache", "-o", plain.to_str().unwrap()])
+        .status
+        .success());
+    let centre = read_grid(&dir.join("field.h0.v0.bin"), None).unwrap();
+    let on_axis = read_grid(&plain, None).unwrap();
+    assert!(centre.sets[0].texels == on_axis.sets[0].texels);
+    let side = read_grid(&dir.join("field.h30.v0.bin"), None).unwrap();
+    let mirror = read_grid(&dir.join("field.h-30.v0.bin"), None).unwrap();
+    let r = |g: &ocular::psf::kernels::KernelGrid| g.sets[0].radius_px[0][1];
+    assert!(r(&side) > r(&centre) + 0.5, "{} vs {}", r(&side), r(&centre));
+    // mirror images up to the resampling grid's asymmetry (a few thousandths of a pixel)
+    assert!((r(&side) - r(&mirror)).abs() < 0.02);
+    // Bad ranges and options are refused at the parser.
+    for bad in [
+        vec!["--field-deg", "-61..0:2,0..0:1"],
+        vec!["--field-deg", "0..10:40,0..0:1"],
+        vec!["--field-deg", "0..10"],
+    ] {
+        let mut a = bad.clone();
+        a.extend_from_slice(&["-o", index.to_str().unwrap()]);
+        refused(&kernels(&dir, &a), "--field-deg");
+    }
+    let png = dir.join("p.png");
+    let mut a = vec!["--field-deg", "0..10:2,0..0:1", "-o", index.to_str().unwrap()];
+    a.extend_from_slice(&["--preview", png.to_str().unwrap()]);
+    refused(&kernels(&dir, &a), "--field-deg");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -126,3 +126,4 @@ fn field_axes_parse_and_frame_range() {
     assert!((h - (30f64.to_radians().tan() * 16.0 / 9.0).atan().to_degrees()).abs() < 1e-12);
     assert!((h - 45.8).abs() < 0.1 && v == 30.0);
 }
+

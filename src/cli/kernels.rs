@@ -11,6 +11,7 @@ use std::time::Instant;
 use crate::eye::Eye;
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
 use crate::psf::cache::{cached, default_cache_dir, grid_key, write_grid, CacheOutcome};
+use crate::psf::field::FieldAxes;
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::DioptreAxis;
 use crate::psf::plan::{plan_for_scene, SceneNeeds};
@@ -66,6 +67,11 @@ pub struct KernelsArgs {
     /// Plot PNG: projected PSF size against object dioptres per channel for two focus states.
     #[arg(long, value_name = "PNG")]
     pub plot: Option<PathBuf>,
+    /// Grids over the visual field: H0..H1:N,V0..V1:M (degrees, N and M 1–31, each angle
+    /// within ±60° and every direction at most 60° off axis). Writes an index (TOML) to -o and
+    /// one grid per direction next to it (STEM.hH.vV.bin); each is cached on its own.
+    #[arg(long, value_name = "H0..H1:N,V0..V1:M", allow_hyphen_values = true)]
+    pub field_deg: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -175,8 +181,20 @@ struct Summary<'a> {
 }
 
 pub fn run(args: &KernelsArgs) -> Result<()> {
+    let field = match &args.field_deg {
+        Some(text) => Some(FieldAxes::parse(text).map_err(Error::input)?),
+        None => None,
+    };
+    if field.is_some() && (args.preview.is_some() || args.plot.is_some()) {
+        return Err(Error::input(
+            "--field-deg writes one grid per direction; --preview and --plot draw a single grid",
+        ));
+    }
     let mut outputs = super::outputs::Outputs::new();
-    outputs.add("-o", &args.output, &[])?;
+    match &field {
+        Some(f) => super::kernels_field::register(&mut outputs, &args.output, f)?,
+        None => outputs.add("-o", &args.output, &[])?,
+    }
     if let Some(p) = &args.preview {
         outputs.add("--preview", p, &["png"])?;
     }
@@ -240,12 +258,26 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         notes = plan.notes;
         axes = plan.axes;
     }
-    let key = grid_key(&eye, &axes, &screen, &settings);
     let dir = if args.no_cache {
         None
     } else {
         args.cache.clone().or_else(default_cache_dir)
     };
+    if let Some(f) = &field {
+        return super::kernels_field::run(
+            outputs,
+            &args.output,
+            &args.eye,
+            &eye,
+            &axes,
+            &screen,
+            &settings,
+            f,
+            dir.as_deref(),
+            args.json,
+        );
+    }
+    let key = grid_key(&eye, &axes, &screen, &settings);
     let bars = Bars::new();
     let t = Instant::now();
     let progress = |s: Stage, d: usize, n: usize| bars.update(s, d, n);
