@@ -154,11 +154,11 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     assert!(kernels(&dir, &["--no-cache", "-o", plain.to_str().unwrap()])
         .status
         .success());
-    let centre = read_grid(&dir.join("field.h0.v0.bin"), None).unwrap();
+    let centre = read_grid(&dir.join("field.h1.v0.bin"), None).unwrap();
     let on_axis = read_grid(&plain, None).unwrap();
     assert!(centre.sets[0].texels == on_axis.sets[0].texels);
-    let side = read_grid(&dir.join("field.h30.v0.bin"), None).unwrap();
-    let mirror = read_grid(&dir.join("field.h-30.v0.bin"), None).unwrap();
+    let side = read_grid(&dir.join("field.h2.v0.bin"), None).unwrap();
+    let mirror = read_grid(&dir.join("field.h0.v0.bin"), None).unwrap();
     let r = |g: &ocular::psf::kernels::KernelGrid| g.sets[0].radius_px[0][1];
     assert!(r(&side) > r(&centre) + 0.5, "{} vs {}", r(&side), r(&centre));
     // mirror images up to the resampling grid's asymmetry (a few thousandths of a pixel)
@@ -173,6 +173,22 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
         a.extend_from_slice(&["-o", index.to_str().unwrap()]);
         refused(&kernels(&dir, &a), "--field-deg");
     }
+    // auto: the frame's range (160 × 180 px at 40°) at measured steps.
+    let auto = dir.join("auto.toml");
+    let out = kernels(
+        &dir,
+        &["--field-deg", "auto", "--width", "160", "-o", auto.to_str().unwrap()],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let idx: toml::Table = std::fs::read_to_string(&auto).unwrap().parse().unwrap();
+    let first = |k: &str| idx[k].as_array().unwrap()[0].as_float().unwrap();
+    let h = (20f64.to_radians().tan() * 160.0 / 180.0).atan().to_degrees();
+    assert!((first("h_deg") + h).abs() < 1e-9 && (first("v_deg") + 20.0).abs() < 1e-9);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("field plan:"));
+    refused(
+        &kernels(&dir, &["--width", "8", "--field-deg", "auto", "-o", auto.to_str().unwrap()]),
+        "--width",
+    );
     let png = dir.join("p.png");
     let mut a = vec!["--field-deg", "0..10:2,0..0:1", "-o", index.to_str().unwrap()];
     a.extend_from_slice(&["--preview", png.to_str().unwrap()]);

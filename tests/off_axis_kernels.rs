@@ -127,3 +127,49 @@ fn field_axes_parse_and_frame_range() {
     assert!((h - 45.8).abs() < 0.1 && v == 30.0);
 }
 
+
+/// The plan covers only the frame and its steps pass the measured tolerance; a plan with a
+/// node fewer per axis fails it (the count is the coarsest that passes).
+#[test]
+fn field_plan_covers_the_frame_with_the_coarsest_passing_steps() {
+    use ocular::psf::field_plan::{plan_field_axes, Probe, FIELD_TOLERANCE_UM};
+    let sys = Eye::navarro_wide().system().unwrap();
+    let probe = Probe {
+        sys: &sys,
+        wavelength_nm: 555.0,
+        pupil_mm: 4.0,
+        object_distance_m: None,
+    };
+    let plan = plan_field_axes(&probe, 60.0, 1280, 720, FIELD_TOLERANCE_UM).unwrap();
+    let [h, v] = frame_half_field_deg(60.0, 1280, 720);
+    let a = &plan.axes;
+    assert!((a.h_deg[0] + h).abs() < 1e-9 && (a.h_deg.last().unwrap() - h).abs() < 1e-9);
+    assert!((a.v_deg[0] + v).abs() < 1e-9 && (a.v_deg.last().unwrap() - v).abs() < 1e-9);
+    eprintln!(
+        "plan: {} × {} nodes, worst {:.4} µm",
+        a.h_deg.len(),
+        a.v_deg.len(),
+        plan.worst_error_um
+    );
+    assert!(plan.worst_error_um <= FIELD_TOLERANCE_UM);
+    // Independent check along h: linear interpolation at quarter points of each step.
+    let coeffs = |f: [f64; 2]| {
+        let m = measure_field(&sys, 555.0, 4.0, None, f, 6).unwrap();
+        m.measurement.coefficients_um
+    };
+    let fewer = a.h_deg.len() - 1;
+    let xs = ocular::psf::axes::linspace(-h, h, fewer);
+    let mut worst_fewer = 0.0f64;
+    for k in 0..fewer - 1 {
+        let (c0, c1) = (coeffs([xs[k], 0.0]), coeffs([xs[k + 1], 0.0]));
+        let cm = coeffs([0.5 * (xs[k] + xs[k + 1]), 0.0]);
+        let e: f64 = (3..c0.len()).map(|j| (0.5 * (c0[j] + c1[j]) - cm[j]).powi(2)).sum();
+        worst_fewer = worst_fewer.max(e.sqrt());
+    }
+    assert!(worst_fewer > FIELD_TOLERANCE_UM, "one node fewer still passes: {worst_fewer}");
+    // A frame beyond the traced field is clamped, and says so.
+    let wide = plan_field_axes(&probe, 100.0, 1920, 1080, 0.2).unwrap();
+    assert!(!wide.notes.is_empty());
+    let corner = [*wide.axes.h_deg.last().unwrap(), *wide.axes.v_deg.last().unwrap()];
+    assert!(ocular::eye::field::eccentricity_deg(corner) <= 60.0);
+}
