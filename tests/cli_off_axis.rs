@@ -32,7 +32,11 @@ fn measure_json(field: &str) -> serde_json::Value {
         field,
         "--json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -40,7 +44,13 @@ fn measure_json(field: &str) -> serde_json::Value {
 fn measure_off_axis_prints_the_on_axis_json_and_its_pupil() {
     let on = measure_json("0,0");
     let off = measure_json("-30,0");
-    for key in ["coefficients", "refraction", "coefficients_um", "power_d", "rms_um"] {
+    for key in [
+        "coefficients",
+        "refraction",
+        "coefficients_um",
+        "power_d",
+        "rms_um",
+    ] {
         assert!(off.get(key).is_some(), "{key} missing");
     }
     let j0 = off["refraction"]["j0"].as_f64().unwrap();
@@ -137,30 +147,51 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     let index = dir.join("field.toml");
     let out = kernels(
         &dir,
-        &["--field-deg", "-30..30:3,0..0:1", "-o", index.to_str().unwrap()],
+        &[
+            "--field-deg",
+            "-30..30:3,0..0:1",
+            "-o",
+            index.to_str().unwrap(),
+        ],
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = std::fs::read_to_string(&index).unwrap();
     assert_eq!(text.matches("[[node]]").count(), 3);
     assert_eq!(text.matches("cached = false").count(), 3);
     let again = kernels(
         &dir,
-        &["--field-deg", "-30..30:3,0..0:1", "-o", index.to_str().unwrap()],
+        &[
+            "--field-deg",
+            "-30..30:3,0..0:1",
+            "-o",
+            index.to_str().unwrap(),
+        ],
     );
     assert!(again.status.success());
     let text = std::fs::read_to_string(&index).unwrap();
     assert_eq!(text.matches("cached = true").count(), 3, "{text}");
     let plain = dir.join("plain.bin");
-    assert!(kernels(&dir, &["--no-cache", "-o", plain.to_str().unwrap()])
-        .status
-        .success());
+    assert!(
+        kernels(&dir, &["--no-cache", "-o", plain.to_str().unwrap()])
+            .status
+            .success()
+    );
     let centre = read_grid(&dir.join("field.h1.v0.bin"), None).unwrap();
     let on_axis = read_grid(&plain, None).unwrap();
     assert!(centre.sets[0].texels == on_axis.sets[0].texels);
     let side = read_grid(&dir.join("field.h2.v0.bin"), None).unwrap();
     let mirror = read_grid(&dir.join("field.h0.v0.bin"), None).unwrap();
     let r = |g: &ocular::psf::kernels::KernelGrid| g.sets[0].radius_px[0][1];
-    assert!(r(&side) > r(&centre) + 0.5, "{} vs {}", r(&side), r(&centre));
+    assert!(
+        r(&side) > r(&centre) + 0.5,
+        "{} vs {}",
+        r(&side),
+        r(&centre)
+    );
     // mirror images up to the resampling grid's asymmetry (a few thousandths of a pixel)
     assert!((r(&side) - r(&mirror)).abs() < 0.02);
     // Bad ranges and options are refused at the parser.
@@ -177,20 +208,48 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     let auto = dir.join("auto.toml");
     let out = kernels(
         &dir,
-        &["--field-deg", "auto", "--width", "160", "-o", auto.to_str().unwrap()],
+        &[
+            "--field-deg",
+            "auto",
+            "--width",
+            "160",
+            "-o",
+            auto.to_str().unwrap(),
+        ],
     );
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let idx: toml::Table = std::fs::read_to_string(&auto).unwrap().parse().unwrap();
     let first = |k: &str| idx[k].as_array().unwrap()[0].as_float().unwrap();
-    let h = (20f64.to_radians().tan() * 160.0 / 180.0).atan().to_degrees();
+    let h = (20f64.to_radians().tan() * 160.0 / 180.0)
+        .atan()
+        .to_degrees();
     assert!((first("h_deg") + h).abs() < 1e-9 && (first("v_deg") + 20.0).abs() < 1e-9);
     assert!(String::from_utf8_lossy(&out.stderr).contains("field plan:"));
     refused(
-        &kernels(&dir, &["--width", "8", "--field-deg", "auto", "-o", auto.to_str().unwrap()]),
+        &kernels(
+            &dir,
+            &[
+                "--width",
+                "8",
+                "--field-deg",
+                "auto",
+                "-o",
+                auto.to_str().unwrap(),
+            ],
+        ),
         "--width",
     );
     let png = dir.join("p.png");
-    let mut a = vec!["--field-deg", "0..10:2,0..0:1", "-o", index.to_str().unwrap()];
+    let mut a = vec![
+        "--field-deg",
+        "0..10:2,0..0:1",
+        "-o",
+        index.to_str().unwrap(),
+    ];
     a.extend_from_slice(&["--preview", png.to_str().unwrap()]);
     refused(&kernels(&dir, &a), "--field-deg");
     let _ = std::fs::remove_dir_all(&dir);

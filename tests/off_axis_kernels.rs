@@ -116,8 +116,17 @@ fn field_axes_parse_and_frame_range() {
     assert_eq!(a.h_deg, vec![-40.0, -20.0, 0.0, 20.0, 40.0]);
     assert_eq!(a.v_deg, vec![-20.0, 0.0, 20.0]);
     assert_eq!(a.nodes().len(), 15);
-    assert_eq!(FieldAxes::parse("10..10:1,0..0:1").unwrap().nodes(), vec![[10.0, 0.0]]);
-    for bad in ["-70..0:3,0..0:1", "0..10:0,0..0:1", "10..0:3,0..0:1", "0..10:3", "55..55:1,55..55:1"] {
+    assert_eq!(
+        FieldAxes::parse("10..10:1,0..0:1").unwrap().nodes(),
+        vec![[10.0, 0.0]]
+    );
+    for bad in [
+        "-70..0:3,0..0:1",
+        "0..10:0,0..0:1",
+        "10..0:3,0..0:1",
+        "0..10:3",
+        "55..55:1,55..55:1",
+    ] {
         let e = FieldAxes::parse(bad).unwrap_err();
         assert!(e.contains("--field-deg"), "{e}");
     }
@@ -126,7 +135,6 @@ fn field_axes_parse_and_frame_range() {
     assert!((h - (30f64.to_radians().tan() * 16.0 / 9.0).atan().to_degrees()).abs() < 1e-12);
     assert!((h - 45.8).abs() < 0.1 && v == 30.0);
 }
-
 
 /// The plan covers only the frame and its steps pass the measured tolerance; a plan with a
 /// node fewer per axis fails it (the count is the coarsest that passes).
@@ -163,13 +171,21 @@ fn field_plan_covers_the_frame_with_the_coarsest_passing_steps() {
     for k in 0..fewer - 1 {
         let (c0, c1) = (coeffs([xs[k], 0.0]), coeffs([xs[k + 1], 0.0]));
         let cm = coeffs([0.5 * (xs[k] + xs[k + 1]), 0.0]);
-        let e: f64 = (3..c0.len()).map(|j| (0.5 * (c0[j] + c1[j]) - cm[j]).powi(2)).sum();
+        let e: f64 = (3..c0.len())
+            .map(|j| (0.5 * (c0[j] + c1[j]) - cm[j]).powi(2))
+            .sum();
         worst_fewer = worst_fewer.max(e.sqrt());
     }
-    assert!(worst_fewer > FIELD_TOLERANCE_UM, "one node fewer still passes: {worst_fewer}");
+    assert!(
+        worst_fewer > FIELD_TOLERANCE_UM,
+        "one node fewer still passes: {worst_fewer}"
+    );
     // A frame beyond the traced field is clamped, and says so.
     let wide = plan_field_axes(&probe, 100.0, 1920, 1080, 0.2).unwrap();
     assert!(!wide.notes.is_empty());
-    let corner = [*wide.axes.h_deg.last().unwrap(), *wide.axes.v_deg.last().unwrap()];
+    let corner = [
+        *wide.axes.h_deg.last().unwrap(),
+        *wide.axes.v_deg.last().unwrap(),
+    ];
     assert!(ocular::eye::field::eccentricity_deg(corner) <= 60.0);
 }

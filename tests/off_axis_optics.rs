@@ -281,7 +281,10 @@ fn wide_angle_eye_matches_an_independent_trace_from_10_to_40_degrees() {
         }
     }
     assert!(flat_misses >= 3, "a flat retina should miss M at 20–40°");
-    assert!(circle_misses >= 3, "the unstretched circle should miss c(3,1) at 20–40°");
+    assert!(
+        circle_misses >= 3,
+        "the unstretched circle should miss c(3,1) at 20–40°"
+    );
 }
 
 /// Oblique astigmatism grows with the square of eccentricity (third-order theory): J0/θ²
@@ -297,9 +300,15 @@ fn oblique_astigmatism_grows_with_the_square_of_eccentricity() {
             .j0
     };
     let base = j0(10.0) / 100.0;
-    assert!(base < 0.0, "horizontal field: J0 negative (tangential meridian stronger)");
+    assert!(
+        base < 0.0,
+        "horizontal field: J0 negative (tangential meridian stronger)"
+    );
     for t in [5.0, 15.0, 20.0, 30.0] {
         let ratio = j0(t) / (t * t) / base;
-        assert!((0.75..1.25).contains(&ratio), "J0/θ² at {t}° is {ratio:.3} of 10°'s");
+        assert!(
+            (0.75..1.25).contains(&ratio),
+            "J0/θ² at {t}° is {ratio:.3} of 10°'s"
+        );
     }
 }

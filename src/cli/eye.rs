@@ -585,8 +585,9 @@ fn run_list() -> Result<()> {
             ),
             None => match name {
                 "navarro" => "Navarro's relaxed schematic eye".to_string(),
-                "navarro-wide" => "Escudero-Sanz & Navarro's wide-angle eye (12 mm retina)"
-                    .to_string(),
+                "navarro-wide" => {
+                    "Escudero-Sanz & Navarro's wide-angle eye (12 mm retina)".to_string()
+                }
                 _ => "the seed paper's Table 1 means, taken literally".to_string(),
             },
         };

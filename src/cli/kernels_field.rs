@@ -4,10 +4,10 @@
 //! (I, J the indices of its angles on the two axes).
 
 use super::outputs::Outputs;
+use crate::eye::accommodate;
 use crate::eye::Eye;
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
 use crate::psf::cache::{cached, write_grid, CacheOutcome};
-use crate::eye::accommodate;
 use crate::psf::defocus::distance_of;
 use crate::psf::field::{compute_field_grid, field_grid_key, FieldAxes};
 use crate::psf::field_plan::{plan_field_axes, FieldPlan, Probe, FIELD_TOLERANCE_UM};
@@ -28,7 +28,9 @@ pub fn node_path(index: &Path, ij: [usize; 2]) -> PathBuf {
 /// (h index, v index) of every node in the order of [`FieldAxes::nodes`].
 fn indices(field: &FieldAxes) -> Vec<[usize; 2]> {
     let nv = field.v_deg.len();
-    (0..field.h_deg.len() * nv).map(|k| [k / nv, k % nv]).collect()
+    (0..field.h_deg.len() * nv)
+        .map(|k| [k / nv, k % nv])
+        .collect()
 }
 
 #[derive(serde::Serialize)]

@@ -30,8 +30,8 @@
 //! the retina at that eccentricity: peripheral refraction.
 
 use super::measure::{
-    check_inputs, dist, measure, path_to_sphere, rho2_coefficient, truncate, Measurement,
-    Measurer, Refraction,
+    check_inputs, dist, measure, path_to_sphere, rho2_coefficient, truncate, Measurement, Measurer,
+    Refraction,
 };
 use super::model::EyeError;
 use super::paraxial::paraxial;
@@ -93,14 +93,20 @@ pub fn check_field_deg(field_deg: [f64; 2]) -> Result<(), EyeError> {
 
 /// Object-space unit direction of field (h, v) degrees.
 pub fn field_direction(field_deg: [f64; 2]) -> V3 {
-    let (x, y) = (field_deg[0].to_radians().tan(), field_deg[1].to_radians().tan());
+    let (x, y) = (
+        field_deg[0].to_radians().tan(),
+        field_deg[1].to_radians().tan(),
+    );
     let l = (x * x + y * y + 1.0).sqrt();
     [x / l, y / l, 1.0 / l]
 }
 
 /// Angle of field (h, v) from the axis, degrees.
 pub fn eccentricity_deg(field_deg: [f64; 2]) -> f64 {
-    let (x, y) = (field_deg[0].to_radians().tan(), field_deg[1].to_radians().tan());
+    let (x, y) = (
+        field_deg[0].to_radians().tan(),
+        field_deg[1].to_radians().tan(),
+    );
     x.hypot(y).atan().to_degrees()
 }
 
@@ -240,10 +246,7 @@ fn rim(b: &Bundle, radial: [f64; 2], iris_r: f64, chief: [f64; 2], scale: f64) -
     ];
     let axes = [t, [-t[0], -t[1]], s, [-s[0], -s[1]]];
     for k in 0..4 {
-        let guess = [
-            chief[0] + scale * axes[k][0],
-            chief[1] + scale * axes[k][1],
-        ];
+        let guess = [chief[0] + scale * axes[k][0], chief[1] + scale * axes[k][1]];
         labels[k] = b.through_iris(targets[k], guess)?;
     }
     let pdot = |a: [f64; 2], v: [f64; 2]| a[0] * v[0] + a[1] * v[1];
@@ -293,7 +296,14 @@ pub fn measure_field(
             field: pupil,
         });
     } else {
-        measure_off_axis(meas, sys, wavelength_nm, pupil_mm, object_distance_m, field_deg)?
+        measure_off_axis(
+            meas,
+            sys,
+            wavelength_nm,
+            pupil_mm,
+            object_distance_m,
+            field_deg,
+        )?
     };
     Ok(FieldMeasurement {
         measurement: truncate(m.measurement, max_order),

@@ -130,9 +130,8 @@ pub fn cropped_field_psf(
     let s_min = 0.5 * (tr - (tr * tr - 4.0 * det).max(0.0).sqrt());
     let pitch_phys = pitch_lambda_na(ch, screen, settings);
     let mut pitch = pitch_phys * s_min;
-    let half_extent = ray_extent(&alpha, ch.wavelength_nm, f) * 1.02
-        + settings.diffraction_margin
-        + pitch_phys;
+    let half_extent =
+        ray_extent(&alpha, ch.wavelength_nm, f) * 1.02 + settings.diffraction_margin + pitch_phys;
     let mut half = (half_extent / pitch).ceil() as usize;
     if 2 * half + 1 > MAX_PSF_SIDE {
         half = MAX_PSF_SIDE / 2;
