@@ -71,7 +71,7 @@ fn every_new_option_is_range_checked_at_the_parser() {
     for bad in [
         ["--pupil-mm", "0.5"],
         ["--vertex-mm", "17"],
-        ["--wavelength-nm", "900"],
+        ["--wavelength-nm", "1001"],
     ] {
         let o = ocular(&["eye", "refract", "myopia", bad[0], bad[1]]);
         let text = String::from_utf8_lossy(&o.stderr);

@@ -315,6 +315,7 @@ fn an_ideal_lens_focuses_a_plane_wave_at_its_focal_length_with_equal_paths() {
         stop_index: 0,
         stop_z_mm: 0.0,
         retina_z_mm: 1000.0,
+        retina_radius_mm: f64::INFINITY,
         lens_index_offset: 0.0,
     };
     let n = sys.indices(NM);

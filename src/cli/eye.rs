@@ -119,6 +119,11 @@ pub struct MeasureArgs {
     /// Highest Zernike order (1–10).
     #[arg(long, default_value_t = 6)]
     pub order: u32,
+    /// Field direction "H,V" in degrees (object space; H towards +x, V towards +y), each
+    /// within ±60° and at most 60° from the axis. Off axis the coefficients are fitted over
+    /// the elliptical pupil stretched to the unit disc (see README, "Off axis").
+    #[arg(long, value_name = "H,V", allow_hyphen_values = true)]
+    pub field_deg: Option<String>,
     /// Print the measurement as JSON.
     #[arg(long)]
     pub json: bool,
@@ -441,7 +446,27 @@ fn parse_focus(s: &str) -> Result<Option<f64>> {
     }
 }
 
+/// Parses "H,V" degrees for `--field-deg`, range-checked.
+pub fn parse_field_deg(s: &str) -> Result<[f64; 2]> {
+    let bad = || {
+        Error::input(format!(
+            "--field-deg {s:?} is not allowed; need \"H,V\" in degrees, each within ±{m}° and \
+             at most {m}° from the axis",
+            m = eye::field::MAX_FIELD_DEG
+        ))
+    };
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != 2 {
+        return Err(bad());
+    }
+    let h: f64 = parts[0].trim().parse().map_err(|_| bad())?;
+    let v: f64 = parts[1].trim().parse().map_err(|_| bad())?;
+    eye::field::check_field_deg([h, v]).map_err(|_| bad())?;
+    Ok([h, v])
+}
+
 fn run_measure(a: &MeasureArgs) -> Result<()> {
+    let field = a.field_deg.as_deref().map(parse_field_deg).transpose()?;
     let f = eye_file::resolve(&a.eye)?;
     check_pupil(a.pupil_mm)?;
     crate::limits::WAVELENGTH_NM
@@ -465,13 +490,18 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
             (f.eye, f.limit)
         }
     };
-    let m = eye::measure(
-        &focused.system()?,
-        a.wavelength_nm,
-        a.pupil_mm,
-        focus,
-        a.order,
-    )?;
+    let sys = focused.system()?;
+    let (m, pupil) = match field {
+        None => (
+            eye::measure(&sys, a.wavelength_nm, a.pupil_mm, focus, a.order)?,
+            None,
+        ),
+        Some(fd) => {
+            let r =
+                eye::field::measure_field(&sys, a.wavelength_nm, a.pupil_mm, focus, fd, a.order)?;
+            (r.measurement, Some(r.field))
+        }
+    };
     if a.json {
         #[derive(serde::Serialize)]
         struct Out<'a> {
@@ -483,6 +513,8 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
             physiology: &'a super::correction::Physiology,
             #[serde(flatten)]
             rest: &'a eye::Measurement,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            field: Option<&'a eye::field::FieldPupil>,
         }
         println!(
             "{}",
@@ -493,13 +525,24 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
                 focus_limit,
                 physiology: &physiology,
                 rest: &m,
+                field: pupil.as_ref(),
             })?
         );
         return Ok(());
     }
+    let at = match &pupil {
+        Some(p) => format!(
+            ", field ({}, {})° (ellipse {:.3} × {:.3} mm)",
+            p.field_deg[0],
+            p.field_deg[1],
+            2.0 * p.semi_axes_mm[0],
+            2.0 * p.semi_axes_mm[1]
+        ),
+        None => String::new(),
+    };
     println!(
-        "{} mm pupil, {} nm, focused at {}: power {:.3} D; M {:+.3} D, J0 {:+.3} D, J45 {:+.3} D; \
-         HO RMS {:.4} µm",
+        "{} mm pupil, {} nm, focused at {}{at}: power {:.3} D; M {:+.3} D, J0 {:+.3} D, \
+         J45 {:+.3} D; HO RMS {:.4} µm",
         a.pupil_mm,
         a.wavelength_nm,
         focus.map_or("infinity".to_string(), |d| format!("{d} m")),
@@ -579,6 +622,9 @@ fn run_list() -> Result<()> {
             ),
             None => match name {
                 "navarro" => "Navarro's relaxed schematic eye".to_string(),
+                "navarro-wide" => {
+                    "Escudero-Sanz & Navarro's wide-angle eye (12 mm retina)".to_string()
+                }
                 _ => "the seed paper's Table 1 means, taken literally".to_string(),
             },
         };

@@ -11,6 +11,7 @@ use std::time::Instant;
 use crate::eye::Eye;
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
 use crate::psf::cache::{cached, default_cache_dir, grid_key, write_grid, CacheOutcome};
+use crate::psf::field::FieldAxes;
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::DioptreAxis;
 use crate::psf::plan::{plan_for_scene, SceneNeeds};
@@ -43,6 +44,9 @@ pub struct KernelsArgs {
     /// Output image height (pixels).
     #[arg(long, default_value_t = 720)]
     pub height: u32,
+    /// Output image width (pixels, 16–16384) for --field-deg auto [default: 16:9 of --height].
+    #[arg(long)]
+    pub width: Option<u32>,
     /// Largest kernel radius (px); larger natural radii are clamped.
     #[arg(long, default_value_t = 64)]
     pub rmax_cap: u32,
@@ -68,6 +72,14 @@ pub struct KernelsArgs {
     /// Plot PNG: projected PSF size against object dioptres per channel for two focus states.
     #[arg(long, value_name = "PNG")]
     pub plot: Option<PathBuf>,
+    /// Grids over the visual field: H0..H1:N,V0..V1:M (degrees, N and M 1–31, each angle
+    /// within ±60° and every direction at most 60° off axis), or "auto": the range the frame
+    /// shows (--fov-y, --width × --height) with the coarsest steps that keep the measured
+    /// interpolation error of the wavefront within 0.04 µm RMS. Writes an index (TOML) to -o
+    /// and one grid per direction next to it (STEM.hI.vJ.bin, I and J the angles' indices);
+    /// each is cached on its own.
+    #[arg(long, value_name = "H0..H1:N,V0..V1:M", allow_hyphen_values = true)]
+    pub field_deg: Option<String>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -177,8 +189,33 @@ struct Summary<'a> {
 }
 
 pub fn run(args: &KernelsArgs) -> Result<()> {
+    if let Some(w) = args.width {
+        if !(16..=16384).contains(&w) {
+            return Err(Error::input(format!(
+                "--width {w} is not allowed; need 16 to 16384 pixels"
+            )));
+        }
+    }
+    let auto = args.field_deg.as_deref().map(str::trim) == Some("auto");
+    let field = match &args.field_deg {
+        Some(_) if auto => None,
+        Some(text) => Some(FieldAxes::parse(text).map_err(Error::input)?),
+        None => None,
+    };
+    if args.width.is_some() && !auto {
+        return Err(Error::input("--width is only used by --field-deg auto"));
+    }
+    if (auto || field.is_some()) && (args.preview.is_some() || args.plot.is_some()) {
+        return Err(Error::input(
+            "--field-deg writes one grid per direction; --preview and --plot draw a single grid",
+        ));
+    }
     let mut outputs = super::outputs::Outputs::new();
-    outputs.add("-o", &args.output, &[])?;
+    match &field {
+        Some(f) => super::kernels_field::register(&mut outputs, &args.output, f)?,
+        None if auto => outputs.add("-o", &args.output, &["toml"])?,
+        None => outputs.add("-o", &args.output, &[])?,
+    }
     if let Some(p) = &args.preview {
         outputs.add("--preview", p, &["png"])?;
     }
@@ -242,12 +279,52 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         notes = plan.notes;
         axes = plan.axes;
     }
-    let key = grid_key(&eye, &axes, &screen, &settings);
     let dir = if args.no_cache {
         None
     } else {
         args.cache.clone().or_else(default_cache_dir)
     };
+    let mut field = field;
+    if auto {
+        let width = args
+            .width
+            .unwrap_or(((args.height as f64) * 16.0 / 9.0).round() as u32);
+        let plan = super::kernels_field::plan(&eye, &axes, &screen, width)?;
+        for n in &plan.notes {
+            eprintln!("note: {n}");
+        }
+        eprintln!(
+            "field plan: {} × {} directions over ±{:.1}° × ±{:.1}°, interpolation error {:.4} µm \
+             (tolerance {} µm)",
+            plan.axes.h_deg.len(),
+            plan.axes.v_deg.len(),
+            plan.axes.h_deg.last().copied().unwrap_or(0.0),
+            plan.axes.v_deg.last().copied().unwrap_or(0.0),
+            plan.worst_error_um,
+            plan.tolerance_um
+        );
+        let mut fresh = super::outputs::Outputs::new();
+        super::kernels_field::register(&mut fresh, &args.output, &plan.axes)?;
+        fresh.probe()?;
+        drop(outputs);
+        outputs = fresh;
+        field = Some(plan.axes);
+    }
+    if let Some(f) = &field {
+        return super::kernels_field::run(
+            outputs,
+            &args.output,
+            &args.eye,
+            &eye,
+            &axes,
+            &screen,
+            &settings,
+            f,
+            dir.as_deref(),
+            args.json,
+        );
+    }
+    let key = grid_key(&eye, &axes, &screen, &settings);
     let bars = Bars::new();
     let t = Instant::now();
     let progress = |s: Stage, d: usize, n: usize| bars.update(s, d, n);

@@ -12,6 +12,7 @@ mod devices;
 mod eye;
 mod eye_plot;
 mod kernels;
+mod kernels_field;
 mod outputs;
 mod psf;
 mod raster;

@@ -142,6 +142,10 @@ impl Measurer {
         &all[(max_order.min(10) - 7) as usize]
     }
 
+    pub(super) fn pattern(&self) -> &PupilPattern {
+        &self.pattern
+    }
+
     pub fn max_order(&self) -> u32 {
         self.pattern.order
     }
@@ -305,7 +309,7 @@ pub fn measure(
     Ok(truncate(m, max_order))
 }
 
-fn truncate(mut m: Measurement, max_order: u32) -> Measurement {
+pub(super) fn truncate(mut m: Measurement, max_order: u32) -> Measurement {
     if max_order < m.max_order {
         m.coefficients_um.truncate(num_terms(max_order));
         m.max_order = max_order;
@@ -313,7 +317,7 @@ fn truncate(mut m: Measurement, max_order: u32) -> Measurement {
     m
 }
 
-fn check_inputs(
+pub(super) fn check_inputs(
     wavelength_nm: f64,
     pupil_mm: f64,
     object_distance_m: Option<f64>,
@@ -403,13 +407,13 @@ fn spherical_wave_ray(object_mm: f64, aim: [f64; 2], ep_z: f64, start_z: f64) ->
 }
 
 #[inline]
-fn dist(a: V3, b: V3) -> f64 {
+pub(super) fn dist(a: V3, b: V3) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
 /// Signed distance along the ray to the near side of the reference sphere.
 #[inline]
-fn path_to_sphere(ray: &Ray, centre: V3, radius: f64) -> Option<f64> {
+pub(super) fn path_to_sphere(ray: &Ray, centre: V3, radius: f64) -> Option<f64> {
     let q = [
         ray.p[0] - centre[0],
         ray.p[1] - centre[1],
@@ -443,7 +447,7 @@ struct Extra {
 }
 
 /// ρ² coefficient of the radial polynomial R_n^0 times its normalisation √(n+1).
-fn rho2_coefficient(n: u32) -> f64 {
+pub(super) fn rho2_coefficient(n: u32) -> f64 {
     let h = (n / 2) as i64;
     // R_n^0(ρ) = Σ_k (−1)^k (n−k)! / (k! ((n/2−k)!)²) ρ^(n−2k); ρ² is k = n/2 − 1.
     let k = h - 1;

@@ -6,6 +6,7 @@ pub mod age;
 pub mod correction;
 pub mod draw;
 pub mod estimate;
+pub mod field;
 pub mod file;
 pub mod fit;
 pub mod lens;
@@ -23,7 +24,7 @@ pub mod trace;
 
 pub use accommodate::{accommodate, focus_within_range, Accommodation, FocusLimit, Focused};
 pub use measure::{measure, Measurement, Measurer, Refraction};
-pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens};
+pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens, Retina};
 pub use paraxial::{paraxial, Paraxial};
 pub use presets::navarro_accommodated;
 pub use system::OpticalSystem;

@@ -104,6 +104,88 @@ pub struct Eye {
     /// An intraocular lens in place of the crystalline lens (no accommodation).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub iol: Option<Iol>,
+    /// Shape of the image surface. Files without it get the wide-angle retina (a sphere of
+    /// radius 12 mm, Escudero-Sanz & Navarro 1999); on axis the shape changes nothing.
+    #[serde(default, skip_serializing_if = "Retina::is_default")]
+    pub retina: Retina,
+}
+
+/// The image surface: its vertex lies on the axis at `axial_length_mm`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "RetinaTable", into = "RetinaTable")]
+pub enum Retina {
+    /// The plane z = axial length (a paraxial schematic eye's image plane).
+    Plane,
+    /// A sphere concave towards the light, centred on the axis `radius_mm` in front of the
+    /// retinal vertex.
+    Sphere { radius_mm: f64 },
+}
+
+/// Retinal radius of the wide-angle schematic eye (Escudero-Sanz & Navarro 1999), mm.
+pub const WIDE_ANGLE_RETINA_RADIUS_MM: f64 = 12.0;
+/// Accepted retinal radii (mm): human retinas lie well inside; flatter is `shape = "plane"`.
+pub const RETINA_RADIUS_RANGE_MM: (f64, f64) = (8.0, 1000.0);
+
+/// The `[retina]` table as written: `shape = "plane"`, or `shape = "sphere"` with
+/// `radius_mm`.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RetinaTable {
+    shape: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    radius_mm: Option<f64>,
+}
+
+impl TryFrom<RetinaTable> for Retina {
+    type Error = String;
+    fn try_from(t: RetinaTable) -> Result<Self, String> {
+        match (t.shape.as_str(), t.radius_mm) {
+            ("plane", None) => Ok(Retina::Plane),
+            ("sphere", Some(radius_mm)) => Ok(Retina::Sphere { radius_mm }),
+            ("plane", Some(_)) => Err("retina: a plane has no radius_mm".into()),
+            ("sphere", None) => Err("retina: a sphere needs radius_mm".into()),
+            (other, _) => Err(format!(
+                "retina.shape {other:?} is not allowed; use \"sphere\" or \"plane\""
+            )),
+        }
+    }
+}
+
+impl From<Retina> for RetinaTable {
+    fn from(r: Retina) -> Self {
+        match r {
+            Retina::Plane => RetinaTable {
+                shape: "plane".into(),
+                radius_mm: None,
+            },
+            Retina::Sphere { radius_mm } => RetinaTable {
+                shape: "sphere".into(),
+                radius_mm: Some(radius_mm),
+            },
+        }
+    }
+}
+
+impl Default for Retina {
+    fn default() -> Self {
+        Retina::Sphere {
+            radius_mm: WIDE_ANGLE_RETINA_RADIUS_MM,
+        }
+    }
+}
+
+impl Retina {
+    pub fn is_default(&self) -> bool {
+        *self == Retina::default()
+    }
+
+    /// Radius of curvature (mm); infinite for the plane.
+    pub fn radius_mm(&self) -> f64 {
+        match *self {
+            Retina::Plane => f64::INFINITY,
+            Retina::Sphere { radius_mm } => radius_mm,
+        }
+    }
 }
 
 impl Default for Eye {
@@ -207,6 +289,15 @@ impl Eye {
                 }
             }
         }
+        if let Retina::Sphere { radius_mm } = self.retina {
+            let (lo, hi) = RETINA_RADIUS_RANGE_MM;
+            if !(radius_mm.is_finite() && (lo..=hi).contains(&radius_mm)) {
+                return Err(EyeError::Invalid(format!(
+                    "retina.radius_mm must lie in {lo}–{hi} mm (shape = \"plane\" for a flat \
+                     retina), got {radius_mm}"
+                )));
+            }
+        }
         if self.lens.tilt_deg.iter().any(|t| t.abs() >= 45.0) {
             return Err(EyeError::Invalid(format!(
                 "lens.tilt_deg must stay within ±45°, got {:?}",
@@ -308,6 +399,7 @@ impl Eye {
             stop_index,
             stop_z_mm: z_lens,
             retina_z_mm: self.axial_length_mm,
+            retina_radius_mm: self.retina.radius_mm(),
             lens_index_offset: 0.0,
         })
     }

@@ -3,7 +3,10 @@
 
 use super::lens::diameter_volume_from_radii;
 use super::media::Medium;
-use super::model::{Cornea, CornealSurface, Eye, EyeError, Lens, DEFAULT_ELEVATION_RADIUS_MM};
+use super::model::{
+    Cornea, CornealSurface, Eye, EyeError, Lens, Retina, DEFAULT_ELEVATION_RADIUS_MM,
+    WIDE_ANGLE_RETINA_RADIUS_MM,
+};
 use super::surface::Surface;
 use super::system::OpticalSystem;
 
@@ -12,6 +15,9 @@ pub const NAVARRO_CORNEA_THICKNESS_MM: f64 = 0.55;
 pub const NAVARRO_AQUEOUS_MM: f64 = 3.05;
 pub const NAVARRO_LENS_THICKNESS_MM: f64 = 4.0;
 pub const NAVARRO_VITREOUS_MM: f64 = 16.40398;
+/// Vitreous depth of the wide-angle eye (Escudero-Sanz & Navarro 1999): paraxially
+/// emmetropic at 543 nm, axial length 23.9203 mm.
+pub const WIDE_ANGLE_VITREOUS_MM: f64 = 16.3203;
 
 fn cornea(ra: f64, ka: f64, rp: f64, kp: f64, t: f64) -> Cornea {
     Cornea {
@@ -57,7 +63,23 @@ impl Eye {
             accommodation_max_d: None,
             correction: None,
             iol: None,
+            retina: Retina::default(),
         }
+    }
+
+    /// The wide-angle schematic eye of Escudero-Sanz & Navarro (1999): Navarro's relaxed
+    /// surfaces and dispersion, a vitreous of 16.3203 mm and a spherical retina of radius
+    /// 12 mm, built to reproduce off-axis aberrations up to 60°.
+    pub fn navarro_wide() -> Eye {
+        let mut e = Eye::navarro();
+        e.axial_length_mm = NAVARRO_CORNEA_THICKNESS_MM
+            + NAVARRO_AQUEOUS_MM
+            + NAVARRO_LENS_THICKNESS_MM
+            + WIDE_ANGLE_VITREOUS_MM;
+        e.retina = Retina::Sphere {
+            radius_mm: WIDE_ANGLE_RETINA_RADIUS_MM,
+        };
+        e
     }
 
     /// The population means of the seed paper's Table 1, taken literally. Under the lens model
@@ -80,10 +102,11 @@ impl Eye {
             accommodation_max_d: None,
             correction: None,
             iol: None,
+            retina: Retina::default(),
         }
     }
 
-    /// A preset by name: `navarro`, `mean`, or one of the estimated eyes (`healthy`,
+    /// A preset by name: `navarro`, `navarro-wide`, `mean`, or one of the estimated eyes (`healthy`,
     /// `myopia`, `astigmatism`, `keratoconus`; see `eye::file`).
     pub fn preset(name: &str) -> Option<Eye> {
         builtin_preset(name).or_else(|| super::file::preset(name).map(|f| f.eye))
@@ -94,14 +117,16 @@ impl Eye {
 pub(crate) fn builtin_preset(name: &str) -> Option<Eye> {
     match name {
         "navarro" => Some(Eye::navarro()),
+        "navarro-wide" => Some(Eye::navarro_wide()),
         "mean" | "population" => Some(Eye::population_mean()),
         _ => None,
     }
 }
 
 /// Names accepted by [`Eye::preset`].
-pub const PRESET_NAMES: [&str; 6] = [
+pub const PRESET_NAMES: [&str; 7] = [
     "navarro",
+    "navarro-wide",
     "mean",
     "healthy",
     "myopia",
@@ -146,6 +171,7 @@ pub fn navarro_accommodated(accommodation_d: f64) -> Result<OpticalSystem, EyeEr
         stop_index: 2,
         stop_z_mm: z2,
         retina_z_mm: retina,
+        retina_radius_mm: f64::INFINITY,
         lens_index_offset: 9e-5 * (10.0 * a + a * a),
     })
 }

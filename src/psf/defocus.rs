@@ -25,7 +25,8 @@
 //! at the object distance.
 
 use super::axes::KernelSettings;
-use crate::eye::{focus_within_range, measure, Eye, FocusLimit};
+use crate::eye::field::measure_field;
+use crate::eye::{focus_within_range, Eye, FocusLimit};
 use crate::optics::beta::beta_from_alpha;
 use crate::optics::psf::{defocus_f_from_c20, Pupil};
 use crate::optics::zernike::{order_for_len, wavefront_gradient};
@@ -50,6 +51,9 @@ pub struct ChannelOptics {
     pub pupil: Pupil,
     /// Ray displacement of the residual wavefront, ∇W/λ (λ/NA), at pupil points (x, y).
     slopes: Vec<([f64; 2], [f64; 2])>,
+    /// Off axis: how the elliptical pupil maps onto the disc the wavefront is fitted over
+    /// (see [`super::field`]); `None` on axis.
+    pub field: Option<super::field::FieldShape>,
 }
 
 impl ChannelOptics {
@@ -109,6 +113,7 @@ impl ChannelOptics {
                 seconds: t0.elapsed().as_secs_f64(),
             },
             slopes,
+            field: None,
         }
     }
 
@@ -119,10 +124,13 @@ impl ChannelOptics {
     }
 
     /// ENZ defocus parameter for an object at `object_d` dioptres (see the module docs).
+    /// Off axis this is the isotropic part over the stretched disc (the astigmatic part is
+    /// added to each PSF's wavefront, see [`super::field`]).
     pub fn defocus_f(&self, object_d: f64) -> f64 {
         let r = 0.5e-3 * self.pupil_mm;
         let delta = self.focus_vergence - self.vergence_at_pupil(object_d);
-        self.focus_f + PI * delta * r * r / (self.wavelength_nm * 1e-9)
+        let scale = self.field.as_ref().map_or(1.0, |s| s.mean_square());
+        self.focus_f + PI * delta * r * r * scale / (self.wavelength_nm * 1e-9)
     }
 
     /// Geometric (ray) half-extent of the PSF at defocus f, in λ/NA: a pupil point ρ lands at
@@ -184,6 +192,19 @@ impl ColumnOptics {
         wavelengths_nm: [f64; 3],
         settings: &KernelSettings,
     ) -> Result<ColumnOptics> {
+        Self::new_in_field(eye, pupil_mm, focus_d, wavelengths_nm, settings, [0.0, 0.0])
+    }
+
+    /// As [`ColumnOptics::new`], measured for the field direction `field_deg` (degrees; the
+    /// eye still accommodates on axis). Field (0, 0) is the on-axis column.
+    pub fn new_in_field(
+        eye: &Eye,
+        pupil_mm: f64,
+        focus_d: f64,
+        wavelengths_nm: [f64; 3],
+        settings: &KernelSettings,
+        field_deg: [f64; 2],
+    ) -> Result<ColumnOptics> {
         let distance = distance_of(focus_d);
         let f = focus_within_range(
             eye,
@@ -202,28 +223,34 @@ impl ColumnOptics {
         let sys = focused.system()?;
         let mut channels = Vec::with_capacity(3);
         for wavelength_nm in wavelengths_nm {
-            let m = measure(
+            let fm = measure_field(
                 &sys,
                 wavelength_nm,
                 pupil_mm,
                 distance,
+                field_deg,
                 settings.zernike_order,
             )
             .map_err(|e| {
                 Error::input(format!(
                     "cannot measure the eye at pupils-mm {pupil_mm}, {wavelength_nm} nm, \
-                     focus-d {focus_d} D: {e}"
+                     focus-d {focus_d} D, field {field_deg:?}°: {e}"
                 ))
             })?;
+            let m = &fm.measurement;
             let e = m.entrance_pupil_z_mm * 1e-3;
-            channels.push(ChannelOptics::from_wavefront(
+            let mut ch = ChannelOptics::from_wavefront(
                 &m.coefficients_um,
                 wavelength_nm,
                 pupil_mm,
                 vergence_at_pupil(focus_d, e),
                 e,
                 settings,
-            ));
+            );
+            if field_deg != [0.0, 0.0] {
+                ch.field = Some(super::field::FieldShape::from_pupil(&fm.field, pupil_mm));
+            }
+            channels.push(ch);
         }
         let channels: [ChannelOptics; 3] = channels.try_into().expect("three channels");
         Ok(ColumnOptics {

@@ -6,6 +6,8 @@
 //! - [`integrate`]: the PSF integrated over screen pixels of any size.
 //! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs.
 //! - [`exact`]: exact kernels at any vergence for the ground truth.
+//! - [`field`]: kernels for a direction of the visual field (elliptical pupil);
+//!   [`field_plan`]: which directions a frame needs.
 //! - [`cache`]: grid files and the on-disk cache; [`preview`]: contact sheet and size plot.
 //! - [`kernels`]: the contract with the GPU runtime.
 
@@ -13,6 +15,8 @@ pub mod axes;
 pub mod cache;
 pub mod defocus;
 pub mod exact;
+pub mod field;
+pub mod field_plan;
 pub mod grid;
 pub mod integrate;
 pub mod kernels;

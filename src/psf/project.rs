@@ -149,6 +149,9 @@ pub fn cropped_psf(
     screen: &Screen,
     settings: &KernelSettings,
 ) -> Result<CroppedPsf> {
+    if let Some(shape) = &ch.field {
+        return super::field::cropped_field_psf(ch, shape, object_d, screen, settings);
+    }
     let f = ch.defocus_f(object_d);
     cropped_psf_at_f(ch, f, screen, settings)
 }
