@@ -130,9 +130,13 @@ pub struct RenderArgs {
     /// Scene time in seconds (keyframes).
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
     pub time: f64,
-    /// Rendering method.
+    /// Rendering method (views: scenes only).
     #[arg(long, value_enum, default_value = "splat")]
     pub method: Method,
+    /// Views over the pupil for --method views (2–65536; default 256). The image converges
+    /// as the views grow; compare --json reports the change when they double.
+    #[arg(long, value_name = "N", value_parser = parse_views)]
+    pub views: Option<u32>,
     /// Screen tile size for splatting: 8, 16 or 32.
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
@@ -198,6 +202,17 @@ fn check_fov(fov_y_deg: f64) -> Result<()> {
         Err(Error::input(format!(
             "--fov-y {fov_y_deg} must be a vertical field of view in (0, 180) degrees"
         )))
+    }
+}
+
+/// `--views N`: a whole number of views within the accepted range.
+pub(crate) fn parse_views(text: &str) -> std::result::Result<u32, String> {
+    use crate::render::views::{MAX_VIEWS, MIN_VIEWS};
+    match text.trim().parse::<u32>() {
+        Ok(n) if (MIN_VIEWS..=MAX_VIEWS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "{text} is not a whole number of views from {MIN_VIEWS} to {MAX_VIEWS}"
+        )),
     }
 }
 
@@ -504,6 +519,15 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     if let Some(fov) = args.fov_y {
         check_fov(fov)?;
     }
+    if args.method == Method::Views && args.color.is_some() {
+        return Err(Error::input(
+            "--method views rasterises a scene from points across the pupil; it cannot render \
+             a --color frame (one view): give a scene",
+        ));
+    }
+    if args.views.is_some() && args.method != Method::Views {
+        return Err(Error::input("--views applies to --method views"));
+    }
     check_file_options(args)?;
     if let Some(ev) = args.exposure {
         if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
@@ -551,6 +575,37 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         &[state],
         screen,
     );
+    if args.method == Method::Views {
+        let views = args.views.unwrap_or(crate::render::views::DEFAULT_VIEWS);
+        let started = std::time::Instant::now();
+        let scene = Scene::load(args.scene.as_deref().unwrap_or("primitives"))?;
+        let scene_state = scene.at_time(args.time);
+        let column = crate::psf::defocus::ColumnOptics::new(
+            &eye,
+            pupil_mm,
+            focus_d,
+            options.reference_axes.wavelengths_nm,
+            &options.settings,
+        )?;
+        let mut rasterizer = Rasterizer::new(&ctx)?;
+        let image = crate::render::views::render(
+            &ctx,
+            &mut rasterizer,
+            &scene_state,
+            (input.width, input.height),
+            &column,
+            focus_d,
+            views,
+        )?;
+        let frame = crate::render::frame::RenderedFrame {
+            color: image.color,
+            method: Method::Views,
+            seconds: started.elapsed().as_secs_f64(),
+            timings: None,
+            stats: None,
+        };
+        return finish(args, &ctx, &input, frame, focus, (focus_d, pupil_mm, pupil_source), None);
+    }
     let kernels = prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
     let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
@@ -570,6 +625,52 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     let frame = renderer.render(&frame_input, state, args.method)?;
 
+    let info = KernelInfo {
+        from_cache,
+        psfs,
+        missed,
+        seconds: seconds_kernels,
+        max_radius,
+    };
+    finish(
+        args,
+        &ctx,
+        &input,
+        frame,
+        focus,
+        (focus_d, pupil_mm, pupil_source),
+        Some(info),
+    )
+}
+
+/// How the kernels of a splat, reference or slices frame were obtained.
+struct KernelInfo {
+    from_cache: bool,
+    psfs: usize,
+    missed: Option<Vec<[f64; 3]>>,
+    seconds: f64,
+    max_radius: u32,
+}
+
+/// Writes the output and prints the summary.
+fn finish(
+    args: &RenderArgs,
+    ctx: &Context,
+    input: &Input,
+    frame: crate::render::frame::RenderedFrame,
+    focus: crate::render::focus::FocusOutcome,
+    (focus_d, pupil_mm, pupil_source): (f64, f64, String),
+    kernels: Option<KernelInfo>,
+) -> Result<()> {
+    let output_ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let (from_cache, psfs, missed, seconds_kernels, max_radius) = match kernels {
+        Some(k) => (k.from_cache, k.psfs, k.missed, k.seconds, k.max_radius),
+        None => (false, 0, None, 0.0, 0),
+    };
     let image = ImageRgba::new(input.width, input.height, frame.color.clone());
     if output_ext.as_deref() == Some("exr") {
         image_io::write_exr_rgba(&args.output, &image)?;
@@ -653,7 +754,13 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         summary.pupil_source,
         args.method.name(),
         frame.seconds,
-        if from_cache { "from cache".to_string() } else { format!("{psfs} PSFs in {seconds_kernels:.1} s") }
+        if args.method == Method::Views {
+            "none".to_string()
+        } else if from_cache {
+            "from cache".to_string()
+        } else {
+            format!("{psfs} PSFs in {seconds_kernels:.1} s")
+        }
     );
     if args.timings {
         if let Some(t) = &frame.timings {

@@ -278,6 +278,24 @@ impl Rasterizer {
         width: u32,
         height: u32,
     ) -> Result<Frame> {
+        let camera = &state.camera;
+        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
+        let view_proj = projection * camera.view_matrix();
+        self.render_from(ctx, state, width, height, view_proj, camera.position_m)
+    }
+
+    /// Renders `state` through `view_proj` (world → clip) seen from `eye_position_m` (where
+    /// view-dependent shading looks from), e.g. an off-axis frustum from a point on the pupil.
+    /// Depth stays the distance along the camera's own view axis.
+    pub fn render_from(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        width: u32,
+        height: u32,
+        view_proj: glam::DMat4,
+        eye_position_m: [f64; 3],
+    ) -> Result<Frame> {
         if width == 0 || height == 0 {
             return Err(Error::input(format!(
                 "frame size {width}×{height} has no pixels"
@@ -289,14 +307,13 @@ impl Rasterizer {
         let camera = &state.camera;
 
         let view = camera.view_matrix();
-        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
         let mut uniform = FrameUniform {
-            view_proj: (projection * view).as_mat4().to_cols_array_2d(),
+            view_proj: view_proj.as_mat4().to_cols_array_2d(),
             view: view.as_mat4().to_cols_array_2d(),
             camera_position: [
-                camera.position_m[0] as f32,
-                camera.position_m[1] as f32,
-                camera.position_m[2] as f32,
+                eye_position_m[0] as f32,
+                eye_position_m[1] as f32,
+                eye_position_m[2] as f32,
                 1.0,
             ],
             ambient: [0.0; 4],
