@@ -173,11 +173,7 @@ fn aberrated_point_centroid_matches_the_eyes_psf() {
         let (_, cv, var) = moments(&out.color, w as usize, c);
         let (natural, kernel) = exact.kernel_checked(c, focus_d).unwrap();
         let side = kernel.side();
-        let pixels: Vec<[f32; 4]> = kernel
-            .values
-            .iter()
-            .map(|&v| [v, v, v, 1.0])
-            .collect();
+        let pixels: Vec<[f32; 4]> = kernel.values.iter().map(|&v| [v, v, v, 1.0]).collect();
         let (_, ck, _) = moments(&pixels, side, 0);
         let kernel_shift = [ck[0] - kernel.radius as f64, ck[1] - kernel.radius as f64];
         let views_shift = [cv[0] - c0[0], cv[1] - c0[1]];
@@ -239,7 +235,10 @@ fn doubling_the_views_changes_the_image_little() {
         db
     };
     let converged = change_db(256, &mut raster);
-    assert!(converged > 60.0, "doubling to 256 views changes {converged} dB");
+    assert!(
+        converged > 60.0,
+        "doubling to 256 views changes {converged} dB"
+    );
     // Negative control: a handful of views is visibly unconverged and fails the bar.
     let coarse = change_db(8, &mut raster);
     assert!(coarse < 60.0, "8 views: {coarse} dB");

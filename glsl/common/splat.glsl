@@ -23,7 +23,7 @@ layout(push_constant) uniform FrameParams {
     uint tile_size;
     uint object_count;     // No
     uint max_radius;       // Rmax
-    uint fragment_count;   // width * height
+    uint fragment_count;   // width * height * layers
     float dioptre_min;
     float dioptre_step;
     float merge_min_radius;
@@ -38,7 +38,7 @@ layout(push_constant) uniform FrameParams {
     uint wide_field;       // 1 = vergence along rays and kernels at the local pinhole scale
     uint entry_capacity;   // entries the list buffer holds: lists past it are not touched
     float saturation_epsilon; // convolution stops once every pixel's coverage is ≥ 1 − ε
-    uint pad0;
+    uint layers;           // depth layers stacked in the inputs and fragments (1 = visible only)
     uint pad1;
     uvec4 pass_u;          // pass-specific values (see each pass)
     vec4 pass_f;

@@ -248,6 +248,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         color: &frame.color,
         depth_m: &frame.depth_m,
         fov_y_deg: screen.fov_y_deg,
+        hidden_layers: &[],
     };
 
     let truth_method = match args.truth {
@@ -329,7 +330,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let views_convergence = convergence_images.as_ref().map(|image| {
         let full = exposed(&image.color, scale);
         let half = exposed(&image.half_color, scale);
-        let quality = ssim(ImageView::new(w, h, &half), ImageView::new(w, h, &full), 1.0);
+        let quality = ssim(
+            ImageView::new(w, h, &half),
+            ImageView::new(w, h, &full),
+            1.0,
+        );
         let max_abs_change = half
             .iter()
             .zip(&full)
@@ -338,7 +343,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         ViewsConvergence {
             views: image.views,
             half_views: image.views.div_ceil(2),
-            psnr_db: psnr(ImageView::new(w, h, &half), ImageView::new(w, h, &full), 1.0),
+            psnr_db: psnr(
+                ImageView::new(w, h, &half),
+                ImageView::new(w, h, &full),
+                1.0,
+            ),
             mssim: quality.mean,
             max_abs_change,
             seconds_raster: image.seconds_raster,

@@ -604,7 +604,15 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             timings: None,
             stats: None,
         };
-        return finish(args, &ctx, &input, frame, focus, (focus_d, pupil_mm, pupil_source), None);
+        return finish(
+            args,
+            &ctx,
+            &input,
+            frame,
+            focus,
+            (focus_d, pupil_mm, pupil_source),
+            None,
+        );
     }
     let kernels = prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
@@ -622,6 +630,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         color: &input.color,
         depth_m: &input.depth_m,
         fov_y_deg: input.fov_y_deg,
+        hidden_layers: &[],
     };
     let frame = renderer.render(&frame_input, state, args.method)?;
 

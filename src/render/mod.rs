@@ -8,7 +8,7 @@ pub mod projection;
 pub mod raster;
 pub mod reference;
 pub mod slices;
-pub mod views;
 pub mod splat;
+pub mod views;
 
 pub use raster::{Frame, Rasterizer, MSAA_SAMPLES};

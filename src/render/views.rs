@@ -220,7 +220,14 @@ pub fn render(
         .collect();
     let half_color = sums[0]
         .iter()
-        .map(|a| [a[0] / even as f32, a[1] / even as f32, a[2] / even as f32, 1.0])
+        .map(|a| {
+            [
+                a[0] / even as f32,
+                a[1] / even as f32,
+                a[2] / even as f32,
+                1.0,
+            ]
+        })
         .collect();
     Ok(ViewsImage {
         color,

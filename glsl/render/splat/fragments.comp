@@ -13,12 +13,15 @@ layout(std430, binding = 2) readonly buffer Radii { vec4 radii[]; };
 layout(std430, binding = 3) writeonly buffer Fragments { Fragment fragments[]; };
 
 void main() {
-    uvec2 p = gl_GlobalInvocationID.xy;
-    if (p.x >= frame.width || p.y >= frame.height) {
+    uvec2 g = gl_GlobalInvocationID.xy;
+    if (g.x >= frame.width || g.y >= frame.height * frame.layers) {
         return;
     }
-    vec3 color = imageLoad(color_in, ivec2(p)).rgb;
-    float depth = imageLoad(depth_in, ivec2(p)).r;
+    // Layers are stacked downwards: row g.y is row p.y of layer g.y / height.
+    uint layer = g.y / frame.height;
+    uvec2 p = uvec2(g.x, g.y - layer * frame.height);
+    vec3 color = imageLoad(color_in, ivec2(g)).rgb;
+    float depth = imageLoad(depth_in, ivec2(g)).r;
     // Infinite, missing or non-positive depth is optical infinity (0 D). Depth is along the
     // view axis; light reaches the eye with the vergence of the distance along the ray.
     bool finite_depth = depth > 0.0 && !isinf(depth) && !isnan(depth);
@@ -38,7 +41,9 @@ void main() {
     f.radius = min(radius, vec3(float(frame.max_radius)));
     f.index = index;
     f.center = vec2(p) + 0.5;
-    f.size = 1u;
+    // A hidden layer is empty where its depth is infinite: no fragment (the visible layer's
+    // infinite depth is the background at optical infinity).
+    f.size = layer > 0u && !finite_depth ? 0u : 1u;
     f.dioptre = dioptre;
-    fragments[p.y * frame.width + p.x] = f;
+    fragments[g.y * frame.width + g.x] = f;
 }

@@ -44,7 +44,11 @@ impl FragmentsPass {
                 Binding::Buffer(fragments),
             ],
             params,
-            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+            [
+                params.width.div_ceil(8),
+                (params.height * params.layers).div_ceil(8),
+                1,
+            ],
         )
     }
 }

@@ -66,7 +66,9 @@ pub(crate) struct FrameParams {
     pub wide_field: u32,
     pub entry_capacity: u32,
     pub saturation_epsilon: f32,
-    pub pad: [u32; 2],
+    /// Depth layers stacked in the inputs and the fragment buffer (1 = the visible surface).
+    pub layers: u32,
+    pub pad: u32,
     pub pass_u: [u32; 4],
     pub pass_f: [f32; 4],
 }
@@ -174,6 +176,16 @@ pub struct FrameInput<'a> {
     pub depth_m: &'a [f32],
     /// Vertical field of view of the pinhole camera that made the frame (degrees).
     pub fov_y_deg: f64,
+    /// The 2nd, 3rd, … surfaces along each pixel's ray (depth peeling, layered EXR), nearest
+    /// first; infinite depth where a layer is empty. Empty: the visible surface only.
+    pub hidden_layers: &'a [HiddenLayer<'a>],
+}
+
+/// One hidden depth layer of a frame: the same layout as the visible one.
+#[derive(Clone, Copy, Debug)]
+pub struct HiddenLayer<'a> {
+    pub color: &'a [[f32; 4]],
+    pub depth_m: &'a [f32],
 }
 
 impl FrameInput<'_> {
@@ -229,6 +241,7 @@ pub struct SplatOutput {
 struct FrameResources {
     width: u32,
     height: u32,
+    layers: u32,
     tiles_x: u32,
     tiles_y: u32,
     color_in: Image,
@@ -351,21 +364,23 @@ impl Splatter {
         (&self.texture, &self.sampler)
     }
 
-    fn ensure_frame(&mut self, width: u32, height: u32) -> crate::Result<()> {
+    fn ensure_frame(&mut self, width: u32, height: u32, layers: u32) -> crate::Result<()> {
         if self
             .frame
             .as_ref()
-            .is_some_and(|f| f.width == width && f.height == height)
+            .is_some_and(|f| f.width == width && f.height == height && f.layers == layers)
         {
             return Ok(());
         }
         let ctx = &self.ctx;
-        let pixels = u64::from(width) * u64::from(height);
+        // every layer's pixels: the inputs and fragments are stacked layer under layer
+        let pixels = u64::from(width) * u64::from(height) * u64::from(layers);
         let limit = binding_limit(ctx);
         if pixels * FRAGMENT_BYTES > limit {
             return Err(crate::Error::input(format!(
-                "a {width}×{height} frame needs {} MiB of fragments, over this device's {} MiB storage-buffer \
-                 binding limit; render at most {} pixels per frame on this device",
+                "a {width}×{height} frame with {layers} depth layer(s) needs {} MiB of fragments, over this \
+                 device's {} MiB storage-buffer binding limit; render at most {} pixels (all layers) per \
+                 frame on this device",
                 (pixels * FRAGMENT_BYTES) >> 20,
                 limit >> 20,
                 limit / FRAGMENT_BYTES
@@ -378,13 +393,14 @@ impl Splatter {
         self.frame = Some(FrameResources {
             width,
             height,
+            layers,
             tiles_x,
             tiles_y,
             color_in: Image::new_2d(
                 ctx,
                 "input colour",
                 width,
-                height,
+                height * layers,
                 TexelFormat::Rgba32Float,
                 storage,
             )?,
@@ -392,7 +408,7 @@ impl Splatter {
                 ctx,
                 "input depth",
                 width,
-                height,
+                height * layers,
                 TexelFormat::R32Float,
                 storage,
             )?,
@@ -421,7 +437,12 @@ impl Splatter {
                 Residency::Upload,
             )?,
             staging_depth: Buffer::new(ctx, "input depth staging", pixels * 4, Residency::Upload)?,
-            readback_color: Buffer::new(ctx, "output read-back", pixels * 16, Residency::Readback)?,
+            readback_color: Buffer::new(
+                ctx,
+                "output read-back",
+                pixels / u64::from(layers) * 16,
+                Residency::Readback,
+            )?,
             readback_lists: Buffer::new(
                 ctx,
                 "list sizes read-back",
@@ -445,7 +466,7 @@ impl Splatter {
             tile_size: self.settings.tile_size,
             object_count: self.grid.objects.count as u32,
             max_radius: self.grid.max_radius_px,
-            fragment_count: frame.width * frame.height,
+            fragment_count: frame.width * frame.height * frame.layers,
             dioptre_min: self.grid.objects.min_d as f32,
             dioptre_step: self.grid.objects.step_d as f32,
             merge_min_radius: merge.min_radius_px,
@@ -463,7 +484,8 @@ impl Splatter {
             wide_field: u32::from(self.settings.blend.wide_field),
             entry_capacity: 0,
             saturation_epsilon: self.settings.saturation_epsilon,
-            pad: [0; 2],
+            layers: frame.layers,
+            pad: 0,
             pass_u: [0; 4],
             pass_f: [0.0; 4],
         }
@@ -498,7 +520,18 @@ impl Splatter {
             )));
         }
         let allocations_before = self.allocations;
-        self.ensure_frame(w, h)?;
+        for (k, layer) in input.hidden_layers.iter().enumerate() {
+            if layer.color.len() != pixels || layer.depth_m.len() != pixels {
+                return Err(crate::Error::input(format!(
+                    "hidden layer {} of a {w}×{h} frame needs {pixels} colour and depth values \
+                     (got {} and {})",
+                    k + 1,
+                    layer.color.len(),
+                    layer.depth_m.len()
+                )));
+            }
+        }
+        self.ensure_frame(w, h, 1 + input.hidden_layers.len() as u32)?;
         let ctx = self.ctx.clone();
         let blend = self.grid.blend(view.pupil_mm, view.focus_d);
         // xyz: natural radius per channel; w: the smallest core radius over the channels,
@@ -516,9 +549,14 @@ impl Splatter {
             let frame = self.frame.as_mut().expect("ensured above");
             write_mapped(&mut frame.staging_color, input.color);
             write_mapped(&mut frame.staging_depth, input.depth_m);
+            for (k, layer) in input.hidden_layers.iter().enumerate() {
+                write_mapped_at(&mut frame.staging_color, (k + 1) * pixels, layer.color);
+                write_mapped_at(&mut frame.staging_depth, (k + 1) * pixels, layer.depth_m);
+            }
             write_mapped(&mut self.radii_staging, &radii);
         }
-        let upload_bytes = (pixels * 20 + radii.len() * 16) as u64;
+        let upload_bytes =
+            (pixels * 20 * (1 + input.hidden_layers.len()) + radii.len() * 16) as u64;
         let frame = self.frame.as_ref().expect("ensured above");
         let mut params = self.params(frame);
         params.focal_px = input.projection().focal_px() as f32;
@@ -866,6 +904,16 @@ fn write_mapped<T: bytemuck::Pod>(buffer: &mut Buffer, data: &[T]) {
     buffer
         .mapped_bytes_mut()
         .expect("upload buffers are host-visible")[..bytes.len()]
+        .copy_from_slice(bytes);
+}
+
+/// Writes `data` into a mapped buffer starting at element `offset` (elements of `T`).
+fn write_mapped_at<T: bytemuck::Pod>(buffer: &mut Buffer, offset: usize, data: &[T]) {
+    let size = std::mem::size_of::<T>();
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    buffer
+        .mapped_bytes_mut()
+        .expect("upload buffers are host-visible")[offset * size..offset * size + bytes.len()]
         .copy_from_slice(bytes);
 }
 

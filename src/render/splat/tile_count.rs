@@ -31,7 +31,11 @@ impl TileCountPass {
             &self.pipeline,
             &[Binding::Buffer(fragments), Binding::Buffer(counts)],
             params,
-            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+            [
+                params.width.div_ceil(8),
+                (params.height * params.layers).div_ceil(8),
+                1,
+            ],
         )
     }
 }

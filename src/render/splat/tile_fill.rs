@@ -43,7 +43,11 @@ impl TileFillPass {
                 Binding::Buffer(entries),
             ],
             params,
-            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+            [
+                params.width.div_ceil(8),
+                (params.height * params.layers).div_ceil(8),
+                1,
+            ],
         )
     }
 }
