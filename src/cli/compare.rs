@@ -89,6 +89,10 @@ pub struct CompareArgs {
     /// Views over the pupil for --truth views (2–65536; default 256).
     #[arg(long, value_name = "N", value_parser = super::render::parse_views)]
     pub views: Option<u32>,
+    /// Also judge splat over K depth-peeled layers ("splat-layers"; 2–8, default 2 where the
+    /// fragments fit the device; 1 = the visible layer only). "splat" stays one layer.
+    #[arg(long, value_name = "K", value_parser = super::render::parse_layers)]
+    pub layers: Option<u32>,
     /// Write the results as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -134,6 +138,11 @@ pub struct MethodResult {
     pub speedup_vs_reference: f64,
     /// GPU time of all passes (splat only).
     pub gpu_ms: Option<f64>,
+    /// Depth layers the method saw.
+    pub layers: u32,
+    /// Quality over the occlusion-edge band (pixels within the local blur radius of a depth
+    /// discontinuity).
+    pub edge_band: super::edge_band::BandQuality,
 }
 
 #[derive(serde::Serialize)]
@@ -213,7 +222,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         outputs.add("--json", path, &["json"])?;
     }
     if let Some(dir) = &args.maps {
-        for name in map_names(args.no_slices, args.truth == TruthArg::Views) {
+        for name in map_names(
+            args.no_slices,
+            args.truth == TruthArg::Views,
+            args.layers.unwrap_or(crate::render::raster::DEFAULT_LAYERS) > 1,
+        ) {
             outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
         }
     }
@@ -240,6 +253,22 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         )
     })?;
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
+    let mut notes = Vec::new();
+    let layers = super::render::scene_layers(&ctx, args.layers, args.size, &mut notes);
+    for n in &notes {
+        println!("note: {n}");
+    }
+    let peeled = if layers > 1 {
+        crate::render::Rasterizer::new(&ctx)?.render_layers(
+            &ctx,
+            &scene.at_time(0.0),
+            args.size,
+            layers,
+            splat.blend.group_tolerance_d,
+        )?
+    } else {
+        Vec::new()
+    };
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     renderer.slice_count = args.slices;
     let input = FrameInput {
@@ -314,6 +343,23 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     // The first splat frame compiles shaders and uploads the kernels: time the second.
     renderer.render(&input, eye_state, Method::Splat)?;
     let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
+    let layered_frame = if peeled.len() > 1 {
+        let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = peeled[1..]
+            .iter()
+            .map(|f| crate::render::splat::HiddenLayer {
+                color: &f.color,
+                depth_m: &f.depth_m,
+            })
+            .collect();
+        let layered = FrameInput {
+            hidden_layers: &hidden,
+            ..input
+        };
+        renderer.render(&layered, eye_state, Method::Splat)?;
+        Some(renderer.render(&layered, eye_state, Method::Splat)?)
+    } else {
+        None
+    };
     let slices_frame = if args.no_slices {
         None
     } else {
@@ -357,16 +403,27 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let mut methods = Vec::new();
     let mut maps = Vec::new();
     let mut window_px = 11;
-    let frames: Vec<&RenderedFrame> = [
-        Some(&truth),
-        reference_frame.as_ref(),
-        Some(&splat_frame),
-        slices_frame.as_ref(),
+    let frames: Vec<(&RenderedFrame, &'static str, u32)> = [
+        Some((&truth, truth_method.name(), 1)),
+        reference_frame.as_ref().map(|f| (f, "reference", 1)),
+        Some((&splat_frame, "splat", 1)),
+        layered_frame
+            .as_ref()
+            .map(|f| (f, "splat-layers", peeled.len() as u32)),
+        slices_frame.as_ref().map(|f| (f, "slices", 1)),
     ]
     .into_iter()
     .flatten()
     .collect();
-    for frame in frames.iter().copied() {
+    let band = super::edge_band::edge_band(
+        &frame.depth_m,
+        (width, height),
+        screen.fov_y_deg,
+        &renderer.kernels().grid,
+        (pupil_mm, focus_d),
+        f64::from(splat.blend.group_tolerance_d),
+    );
+    for &(frame, name, frame_layers) in &frames {
         if let Some((count, first)) = non_finite(&frame.color, w) {
             return Err(Error::input(format!(
                 "the {} image has {count} pixels that are not finite (first at x = {}, y = {}); \
@@ -382,8 +439,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             ImageView::new(w, h, &truth01),
             1.0,
         );
+        let edge_band = super::edge_band::band_quality(&image, &truth01, &quality.map, &band, w);
         methods.push(MethodResult {
-            method: frame.method.name(),
+            method: name,
+            layers: frame_layers,
+            edge_band,
             seconds: frame.seconds,
             psnr_db: psnr(
                 ImageView::new(w, h, &image),
@@ -421,8 +481,15 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         );
     }
     println!(
-        "  {:<10} {:>10} {:>10} {:>10} {:>12}",
-        "method", "PSNR dB", "MSSIM", "seconds", "× faster"
+        "  {:<13} {:>10} {:>10} {:>10} {:>12}   edge band ({} px): {:>8} {:>8}",
+        "method",
+        "PSNR dB",
+        "MSSIM",
+        "seconds",
+        "× faster",
+        methods.first().map_or(0, |m| m.edge_band.pixels),
+        "PSNR dB",
+        "MSSIM"
     );
     for m in &methods {
         let db = if m.psnr_db.is_infinite() {
@@ -430,9 +497,14 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         } else {
             format!("{:.2}", m.psnr_db)
         };
+        let band_db = if m.edge_band.psnr_db.is_infinite() {
+            "∞".to_string()
+        } else {
+            format!("{:.2}", m.edge_band.psnr_db)
+        };
         println!(
-            "  {:<10} {:>10} {:>10.4} {:>10.3} {:>12.1}",
-            m.method, db, m.mssim, m.seconds, m.speedup_vs_reference
+            "  {:<13} {:>10} {:>10.4} {:>10.3} {:>12.1}   {:>28} {:>8.4}",
+            m.method, db, m.mssim, m.seconds, m.speedup_vs_reference, band_db, m.edge_band.mssim
         );
     }
     if let Some(path) = &args.truth_out {
@@ -447,8 +519,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             mode: TonemapMode::Clamp,
         };
         for (i, frame) in frames.iter().enumerate() {
-            let name = if i == 0 { "truth" } else { frame.method.name() };
-            let image = ImageRgba::new(width, height, frame.color.clone());
+            let name = if i == 0 { "truth" } else { frame.1 };
+            let image = ImageRgba::new(width, height, frame.0.color.clone());
             image_io::write_png(
                 outputs.temporary(&dir.join(format!("{name}.png"))),
                 &image,
@@ -460,7 +532,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             mode: TonemapMode::Clamp,
         };
         for (frame, map) in frames[1..].iter().zip(&maps[1..]) {
-            let name = format!("ssim_{}", frame.method.name());
+            let name = format!("ssim_{}", frame.1);
             let rgb: Vec<[f32; 4]> = ssim_false_colour(map, 0.9)
                 .iter()
                 .map(|p| [0, 1, 2].map(|c| image_io::srgb_decode(p[c])))
@@ -512,13 +584,16 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
 }
 
 /// The files `--maps` writes, without extension.
-fn map_names(no_slices: bool, views: bool) -> Vec<&'static str> {
+fn map_names(no_slices: bool, views: bool, layers: bool) -> Vec<&'static str> {
     let mut names = vec!["truth"];
     let mut judged = vec![];
     if views {
         judged.push(("reference", "ssim_reference"));
     }
     judged.push(("splat", "ssim_splat"));
+    if layers {
+        judged.push(("splat-layers", "ssim_splat-layers"));
+    }
     if !no_slices {
         judged.push(("slices", "ssim_slices"));
     }

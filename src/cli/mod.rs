@@ -8,6 +8,7 @@ use crate::Result;
 mod bench;
 mod compare;
 mod devices;
+mod edge_band;
 mod eye;
 mod eye_plot;
 mod kernels;

@@ -137,6 +137,12 @@ pub struct RenderArgs {
     /// as the views grow; compare --json reports the change when they double.
     #[arg(long, value_name = "N", value_parser = parse_views)]
     pub views: Option<u32>,
+    /// Depth layers splat takes (1–8): a scene is depth-peeled to K layers (default 2, fewer
+    /// where the fragments would exceed the device's storage-buffer limit), a layered EXR
+    /// gives its own (at most K). Hidden layers show through blurred edges; reference and
+    /// slices use the visible layer only.
+    #[arg(long, value_name = "K", value_parser = parse_layers)]
+    pub layers: Option<u32>,
     /// Screen tile size for splatting: 8, 16 or 32.
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
@@ -216,6 +222,39 @@ pub(crate) fn parse_views(text: &str) -> std::result::Result<u32, String> {
     }
 }
 
+/// `--layers K`: a whole number of depth layers within the accepted range.
+pub(crate) fn parse_layers(text: &str) -> std::result::Result<u32, String> {
+    let most = crate::inputs::layered::MAX_LAYERS as u32;
+    match text.trim().parse::<u32>() {
+        Ok(k) if (1..=most).contains(&k) => Ok(k),
+        _ => Err(format!(
+            "{text} is not a whole number of layers from 1 to {most}"
+        )),
+    }
+}
+
+/// How many layers a scene is peeled to: `asked`, else the default where it fits the device.
+pub(crate) fn scene_layers(
+    ctx: &Context,
+    asked: Option<u32>,
+    (width, height): (u32, u32),
+    notes: &mut Vec<String>,
+) -> u32 {
+    let fit = crate::render::splat::max_layers(ctx, width, height).max(1);
+    match asked {
+        Some(k) => k,
+        None if fit < crate::render::raster::DEFAULT_LAYERS => {
+            notes.push(format!(
+                "{fit} depth layer(s), not {}: more would exceed this device's storage-buffer \
+                 limit at {width}×{height}",
+                crate::render::raster::DEFAULT_LAYERS
+            ));
+            fit
+        }
+        None => crate::render::raster::DEFAULT_LAYERS,
+    }
+}
+
 fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
     let (x, y) = text
         .split_once(',')
@@ -241,6 +280,8 @@ struct Input {
     focus_m: Option<f64>,
     pupil_mm: Option<f64>,
     luminance_cdm2: Option<f64>,
+    /// Hidden depth layers (colour, depth), nearest first.
+    hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
     label: String,
     /// Where the depth came from, and what the depth policy found (file input).
     depth_source: Option<String>,
@@ -278,6 +319,11 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
             label: file.color_source,
             depth_source: Some(file.depth_source),
             depth_report: Some(file.depth_report),
+            hidden: file
+                .hidden_layers
+                .into_iter()
+                .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
+                .collect(),
             warnings: file.warnings,
         });
     }
@@ -296,9 +342,24 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
     let state = scene.at_time(args.time);
     let (width, height) = args.size.unwrap_or((640, 360));
     let mut rasterizer = Rasterizer::new(ctx)?;
-    let frame = rasterizer.render(ctx, &state, width, height)?;
-    let mut depth_m = frame.depth_m;
     let mut warnings = Vec::new();
+    let k = if args.method == Method::Splat {
+        scene_layers(ctx, args.layers, (width, height), &mut warnings)
+    } else {
+        1
+    };
+    let mut frames = rasterizer
+        .render_layers(
+            ctx,
+            &state,
+            (width, height),
+            k,
+            args.blend.settings().group_tolerance_d,
+        )?
+        .into_iter();
+    let frame = frames.next().expect("layer 0");
+    let hidden = frames.map(|f| (f.color, f.depth_m)).collect();
+    let mut depth_m = frame.depth_m;
     let near = crate::render::focus::nearest_supported_m();
     let clamped = depth_m
         .iter_mut()
@@ -323,6 +384,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
         pupil_mm: state.pupil_mm,
         luminance_cdm2: state.luminance_cd_m2,
         label: format!("scene {name}"),
+        hidden,
         depth_source: None,
         depth_report: None,
         warnings,
@@ -528,6 +590,11 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     if args.views.is_some() && args.method != Method::Views {
         return Err(Error::input("--views applies to --method views"));
     }
+    if args.layers.is_some() && args.method != Method::Splat {
+        return Err(Error::input(
+            "--layers applies to --method splat (reference and slices see the visible layer only)",
+        ));
+    }
     check_file_options(args)?;
     if let Some(ev) = args.exposure {
         if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
@@ -624,13 +691,22 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let seconds_kernels = kernels.seconds;
     let max_radius = kernels.grid.max_radius_px;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
+        .hidden
+        .iter()
+        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
+        .collect();
     let frame_input = FrameInput {
         width: input.width,
         height: input.height,
         color: &input.color,
         depth_m: &input.depth_m,
         fov_y_deg: input.fov_y_deg,
-        hidden_layers: &[],
+        hidden_layers: if args.method == Method::Splat {
+            &hidden
+        } else {
+            &[]
+        },
     };
     let frame = renderer.render(&frame_input, state, args.method)?;
 

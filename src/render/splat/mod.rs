@@ -296,6 +296,12 @@ fn binding_limit(ctx: &Context) -> u64 {
     u64::from(ctx.limits().max_storage_buffer_range)
 }
 
+/// Most depth layers whose fragments fit one storage-buffer binding at `width`×`height`.
+pub fn max_layers(ctx: &Context, width: u32, height: u32) -> u32 {
+    let per_layer = u64::from(width) * u64::from(height) * FRAGMENT_BYTES;
+    (binding_limit(ctx) / per_layer.max(1)).min(u64::from(u32::MAX)) as u32
+}
+
 impl Splatter {
     /// Uploads `grid` and builds every pass. The grid stays resident on the GPU.
     pub fn new(
