@@ -87,11 +87,11 @@ pub struct CompareArgs {
     #[arg(long, value_enum, default_value = "reference")]
     pub truth: TruthArg,
     /// Views over the pupil for --truth views (2–65536; default 256).
-    #[arg(long, value_name = "N", value_parser = super::render::parse_views)]
+    #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
     pub views: Option<u32>,
     /// Also judge splat over K depth-peeled layers ("splat-layers"; 2–8, default 2 where the
     /// fragments fit the device; 1 = the visible layer only). "splat" stays one layer.
-    #[arg(long, value_name = "K", value_parser = super::render::parse_layers)]
+    #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
     pub layers: Option<u32>,
     /// Write the results as JSON.
     #[arg(long, value_name = "FILE")]
@@ -254,7 +254,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     })?;
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let mut notes = Vec::new();
-    let layers = super::render::scene_layers(&ctx, args.layers, args.size, &mut notes);
+    let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
     for n in &notes {
         println!("note: {n}");
     }

@@ -10,7 +10,7 @@ use super::raster::{parse_size, TonemapArg};
 use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+
 use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
 use crate::psf::cache::CacheOutcome;
@@ -135,13 +135,13 @@ pub struct RenderArgs {
     pub method: Method,
     /// Views over the pupil for --method views (2–65536; default 256). The image converges
     /// as the views grow; compare --json reports the change when they double.
-    #[arg(long, value_name = "N", value_parser = parse_views)]
+    #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
     pub views: Option<u32>,
     /// Depth layers splat takes (1–8): a scene is depth-peeled to K layers (default 2, fewer
     /// where the fragments would exceed the device's storage-buffer limit), a layered EXR
     /// gives its own (at most K). Hidden layers show through blurred edges; reference and
     /// slices use the visible layer only.
-    #[arg(long, value_name = "K", value_parser = parse_layers)]
+    #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
     pub layers: Option<u32>,
     /// Screen tile size for splatting: 8, 16 or 32.
     #[arg(long, default_value_t = 8)]
@@ -211,50 +211,6 @@ fn check_fov(fov_y_deg: f64) -> Result<()> {
     }
 }
 
-/// `--views N`: a whole number of views within the accepted range.
-pub(crate) fn parse_views(text: &str) -> std::result::Result<u32, String> {
-    use crate::render::views::{MAX_VIEWS, MIN_VIEWS};
-    match text.trim().parse::<u32>() {
-        Ok(n) if (MIN_VIEWS..=MAX_VIEWS).contains(&n) => Ok(n),
-        _ => Err(format!(
-            "{text} is not a whole number of views from {MIN_VIEWS} to {MAX_VIEWS}"
-        )),
-    }
-}
-
-/// `--layers K`: a whole number of depth layers within the accepted range.
-pub(crate) fn parse_layers(text: &str) -> std::result::Result<u32, String> {
-    let most = crate::inputs::layered::MAX_LAYERS as u32;
-    match text.trim().parse::<u32>() {
-        Ok(k) if (1..=most).contains(&k) => Ok(k),
-        _ => Err(format!(
-            "{text} is not a whole number of layers from 1 to {most}"
-        )),
-    }
-}
-
-/// How many layers a scene is peeled to: `asked`, else the default where it fits the device.
-pub(crate) fn scene_layers(
-    ctx: &Context,
-    asked: Option<u32>,
-    (width, height): (u32, u32),
-    notes: &mut Vec<String>,
-) -> u32 {
-    let fit = crate::render::splat::max_layers(ctx, width, height).max(1);
-    match asked {
-        Some(k) => k,
-        None if fit < crate::render::raster::DEFAULT_LAYERS => {
-            notes.push(format!(
-                "{fit} depth layer(s), not {}: more would exceed this device's storage-buffer \
-                 limit at {width}×{height}",
-                crate::render::raster::DEFAULT_LAYERS
-            ));
-            fit
-        }
-        None => crate::render::raster::DEFAULT_LAYERS,
-    }
-}
-
 fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
     let (x, y) = text
         .split_once(',')
@@ -271,22 +227,22 @@ fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 /// A frame to render, from a scene or from files.
-struct Input {
-    width: u32,
-    height: u32,
-    color: Vec<[f32; 4]>,
-    depth_m: Vec<f32>,
-    fov_y_deg: f64,
-    focus_m: Option<f64>,
-    pupil_mm: Option<f64>,
-    luminance_cdm2: Option<f64>,
+pub(super) struct Input {
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) color: Vec<[f32; 4]>,
+    pub(super) depth_m: Vec<f32>,
+    pub(super) fov_y_deg: f64,
+    pub(super) focus_m: Option<f64>,
+    pub(super) pupil_mm: Option<f64>,
+    pub(super) luminance_cdm2: Option<f64>,
     /// Hidden depth layers (colour, depth), nearest first.
-    hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
-    label: String,
+    pub(super) hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
+    pub(super) label: String,
     /// Where the depth came from, and what the depth policy found (file input).
-    depth_source: Option<String>,
-    depth_report: Option<crate::inputs::DepthReport>,
-    warnings: Vec<String>,
+    pub(super) depth_source: Option<String>,
+    pub(super) depth_report: Option<crate::inputs::DepthReport>,
+    pub(super) warnings: Vec<String>,
 }
 
 fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
@@ -344,7 +300,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
     let mut rasterizer = Rasterizer::new(ctx)?;
     let mut warnings = Vec::new();
     let k = if args.method == Method::Splat {
-        scene_layers(ctx, args.layers, (width, height), &mut warnings)
+        super::occlusion::scene_layers(ctx, args.layers, (width, height), &mut warnings)
     } else {
         1
     };
@@ -483,7 +439,7 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
 fn mean_luminance(color: &[[f32; 4]]) -> f64 {
     let sum: f64 = color
         .iter()
-        .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
+        .map(|p| f64::from(crate::image_io::luminance([p[0], p[1], p[2]])))
         .sum();
     sum / color.len().max(1) as f64
 }
@@ -519,42 +475,6 @@ fn pupil_diameter(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
         PupilModel::MoonSpencer => (moon_spencer_mm(luminance), "Moon–Spencer"),
     };
     Ok((mm, format!("{model} at {luminance:.3} cd/m² ({source})")))
-}
-
-#[derive(serde::Serialize)]
-struct Summary {
-    output: String,
-    input: String,
-    eye: String,
-    width: u32,
-    height: u32,
-    fov_y_deg: f64,
-    /// Where the depth came from (file input only).
-    depth: Option<String>,
-    /// Background, invalid, clamped and constant depth (file input only).
-    depth_report: Option<crate::inputs::DepthReport>,
-    /// The focus asked for (D; 0 = infinity).
-    focus_d: f64,
-    /// Where the eye actually focuses (D): `focus_d`, or its far point when `focus_d` lies
-    /// beyond it (`focus_clamped`).
-    focus_actual_d: f64,
-    focus_clamped: bool,
-    pupil_mm: f64,
-    pupil_source: String,
-    /// Things about the input a user should know (also printed on stderr).
-    warnings: Vec<String>,
-    method: &'static str,
-    seconds_render: f64,
-    seconds_kernels: f64,
-    kernels_from_cache: bool,
-    psfs_computed: usize,
-    /// Worst pupil energy the kernels' PSFs missed, per (pupil, focus) column and channel
-    /// (null when the kernels came from the cache: they were checked when computed).
-    psf_missed_energy: Option<Vec<[f64; 3]>>,
-    max_radius_px: u32,
-    gpu_ms: Option<Vec<(String, f64)>>,
-    gpu_total_ms: Option<f64>,
-    device: String,
 }
 
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
@@ -643,35 +563,17 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         screen,
     );
     if args.method == Method::Views {
-        let views = args.views.unwrap_or(crate::render::views::DEFAULT_VIEWS);
-        let started = std::time::Instant::now();
         let scene = Scene::load(args.scene.as_deref().unwrap_or("primitives"))?;
-        let scene_state = scene.at_time(args.time);
-        let column = crate::psf::defocus::ColumnOptics::new(
-            &eye,
-            pupil_mm,
-            focus_d,
-            options.reference_axes.wavelengths_nm,
-            &options.settings,
-        )?;
-        let mut rasterizer = Rasterizer::new(&ctx)?;
-        let image = crate::render::views::render(
+        let frame = super::occlusion::render_views(
             &ctx,
-            &mut rasterizer,
-            &scene_state,
+            &scene.at_time(args.time),
             (input.width, input.height),
-            &column,
-            focus_d,
-            views,
+            &eye,
+            (pupil_mm, focus_d),
+            args.views,
+            &options,
         )?;
-        let frame = crate::render::frame::RenderedFrame {
-            color: image.color,
-            method: Method::Views,
-            seconds: started.elapsed().as_secs_f64(),
-            timings: None,
-            stats: None,
-        };
-        return finish(
+        return super::render_output::finish(
             args,
             &ctx,
             &input,
@@ -710,14 +612,14 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     let frame = renderer.render(&frame_input, state, args.method)?;
 
-    let info = KernelInfo {
+    let info = super::render_output::KernelInfo {
         from_cache,
         psfs,
         missed,
         seconds: seconds_kernels,
         max_radius,
     };
-    finish(
+    super::render_output::finish(
         args,
         &ctx,
         &input,
@@ -726,141 +628,4 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         (focus_d, pupil_mm, pupil_source),
         Some(info),
     )
-}
-
-/// How the kernels of a splat, reference or slices frame were obtained.
-struct KernelInfo {
-    from_cache: bool,
-    psfs: usize,
-    missed: Option<Vec<[f64; 3]>>,
-    seconds: f64,
-    max_radius: u32,
-}
-
-/// Writes the output and prints the summary.
-fn finish(
-    args: &RenderArgs,
-    ctx: &Context,
-    input: &Input,
-    frame: crate::render::frame::RenderedFrame,
-    focus: crate::render::focus::FocusOutcome,
-    (focus_d, pupil_mm, pupil_source): (f64, f64, String),
-    kernels: Option<KernelInfo>,
-) -> Result<()> {
-    let output_ext = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    let (from_cache, psfs, missed, seconds_kernels, max_radius) = match kernels {
-        Some(k) => (k.from_cache, k.psfs, k.missed, k.seconds, k.max_radius),
-        None => (false, 0, None, 0.0, 0),
-    };
-    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
-    if output_ext.as_deref() == Some("exr") {
-        image_io::write_exr_rgba(&args.output, &image)?;
-    } else {
-        let mode = match args.tonemap {
-            TonemapArg::Clamp => TonemapMode::Clamp,
-            TonemapArg::Reinhard => TonemapMode::Reinhard,
-        };
-        // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
-        let exposure_ev = args.exposure.unwrap_or_else(|| {
-            Tonemap::auto_exposure_ev(&ImageRgba::new(
-                input.width,
-                input.height,
-                input.color.clone(),
-            ))
-        });
-        image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })?;
-    }
-    let gpu: Option<Vec<(String, f64)>> = frame
-        .timings
-        .as_ref()
-        .map(|t| t.passes.iter().map(|p| (p.name.clone(), p.ms)).collect());
-    let summary = Summary {
-        output: args.output.display().to_string(),
-        input: input.label.clone(),
-        eye: args.eye.clone(),
-        width: input.width,
-        height: input.height,
-        fov_y_deg: input.fov_y_deg,
-        depth: input.depth_source.clone(),
-        depth_report: input.depth_report.clone(),
-        focus_d,
-        focus_actual_d: focus.actual_d,
-        focus_clamped: focus.beyond_far_point,
-        pupil_mm,
-        pupil_source,
-        warnings: input.warnings.clone(),
-        method: args.method.name(),
-        seconds_render: frame.seconds,
-        seconds_kernels,
-        kernels_from_cache: from_cache,
-        psfs_computed: psfs,
-        psf_missed_energy: missed,
-        max_radius_px: max_radius,
-        gpu_total_ms: frame.timings.as_ref().map(|t| t.total_ms()),
-        gpu_ms: gpu,
-        device: ctx.device_info().name.clone(),
-    };
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&summary)
-                .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?
-        );
-        return Ok(());
-    }
-    let distance = |d: f64| {
-        if d > 0.0 {
-            format!("{:.3} m", 1.0 / d)
-        } else {
-            "infinity".into()
-        }
-    };
-    let focus = if focus.beyond_far_point {
-        format!(
-            "{} (its far point; asked {}, beyond it)",
-            distance(focus.actual_d),
-            distance(focus_d)
-        )
-    } else {
-        distance(focus_d)
-    };
-    println!(
-        "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
-        summary.output,
-        input.width,
-        input.height,
-        input.label,
-        args.eye,
-        pupil_mm,
-        summary.pupil_source,
-        args.method.name(),
-        frame.seconds,
-        if args.method == Method::Views {
-            "none".to_string()
-        } else if from_cache {
-            "from cache".to_string()
-        } else {
-            format!("{psfs} PSFs in {seconds_kernels:.1} s")
-        }
-    );
-    if args.timings {
-        if let Some(t) = &frame.timings {
-            for p in &t.passes {
-                println!("  {:<12} {:>9.3} ms", p.name, p.ms);
-            }
-            println!(
-                "  {:<12} {:>9.3} ms  (GPU, {})",
-                "total",
-                t.total_ms(),
-                summary.device
-            );
-        } else {
-            println!("  (--timings applies to --method splat)");
-        }
-    }
-    Ok(())
 }
