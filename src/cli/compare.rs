@@ -89,8 +89,8 @@ pub struct CompareArgs {
     /// Views over the pupil for --truth views (2–65536; default 256).
     #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
     pub views: Option<u32>,
-    /// Also judge splat over K depth-peeled layers ("splat-layers"; 2–8, default 2 where the
-    /// fragments fit the device; 1 = the visible layer only). "splat" stays one layer.
+    /// Also judge splat over K depth-peeled layers ("splat-layers", 2–8; 1, the default,
+    /// adds no row). "splat" stays one layer.
     #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
     pub layers: Option<u32>,
     /// Write the results as JSON.

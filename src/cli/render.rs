@@ -137,10 +137,9 @@ pub struct RenderArgs {
     /// as the views grow; compare --json reports the change when they double.
     #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
     pub views: Option<u32>,
-    /// Depth layers splat takes (1–8): a scene is depth-peeled to K layers (default 2, fewer
-    /// where the fragments would exceed the device's storage-buffer limit), a layered EXR
-    /// gives its own (at most K). Hidden layers show through blurred edges; reference and
-    /// slices use the visible layer only.
+    /// Depth layers splat takes (1–8; default 1, see the README's measurements): a scene is
+    /// depth-peeled to K layers, a layered EXR gives its own (at most K; default all). Hidden
+    /// layers show through blurred edges; reference and slices use the visible layer only.
     #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
     pub layers: Option<u32>,
     /// Screen tile size for splatting: 8, 16 or 32.

@@ -21,7 +21,7 @@ use crate::{Error, Result};
 pub const MSAA_SAMPLES: u32 = 4;
 
 /// Depth layers a scene is peeled to for splat unless told otherwise (README: measured).
-pub const DEFAULT_LAYERS: u32 = 2;
+pub const DEFAULT_LAYERS: u32 = 1;
 
 /// A rendered frame on the CPU: row-major, top row first.
 #[derive(Clone, Debug)]
