@@ -60,6 +60,7 @@ impl Frame {
             color: &self.color,
             depth_m: &self.depth,
             fov_y_deg: self.fov_y_deg,
+            hidden_layers: &[],
         }
     }
 }

@@ -40,6 +40,7 @@ impl Frame {
             color: &self.color,
             depth_m: &self.depth,
             fov_y_deg: 10.0,
+            hidden_layers: &[],
         }
     }
 }

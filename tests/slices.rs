@@ -40,6 +40,7 @@ fn slices_are_finite_and_clearly_worse_than_splatting() {
         color: &color,
         depth_m: &depth,
         fov_y_deg: 60.0,
+        hidden_layers: &[],
     };
     let eye = SyntheticEye::new(0.4, 3.0);
     let objects = DioptreAxis::spanning(0.0, 4.0, 33);
@@ -115,6 +116,7 @@ fn the_blend_is_a_convolution_at_equal_depth() {
         color: &color,
         depth_m: &depth,
         fov_y_deg: 2.0,
+        hidden_layers: &[],
     };
     let mut previous = f64::INFINITY;
     for px_per_d in [1.0, 3.0, 6.0] {
@@ -172,6 +174,7 @@ fn slices_are_deterministic() {
         color: &color,
         depth_m: &depth,
         fov_y_deg: 10.0,
+        hidden_layers: &[],
     };
     let exact = ExactSynthetic {
         eye: SyntheticEye::new(0.5, 3.0),

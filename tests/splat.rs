@@ -56,6 +56,7 @@ impl Scene {
             color: &self.color,
             depth_m: &self.depth,
             fov_y_deg: 60.0,
+            hidden_layers: &[],
         }
     }
 }

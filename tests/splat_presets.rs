@@ -66,6 +66,7 @@ fn four_preset_eyes_match_the_ground_truth() {
         color: &color,
         depth_m: &depth,
         fov_y_deg: FOV_Y_DEG,
+        hidden_layers: &[],
     };
     let state = EyeState {
         focus_d: 1.0 / 7.5,

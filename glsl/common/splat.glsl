@@ -23,7 +23,7 @@ layout(push_constant) uniform FrameParams {
     uint tile_size;
     uint object_count;     // No
     uint max_radius;       // Rmax
-    uint fragment_count;   // width * height
+    uint fragment_count;   // width * height * layers
     float dioptre_min;
     float dioptre_step;
     float merge_min_radius;
@@ -39,7 +39,7 @@ layout(push_constant) uniform FrameParams {
     uint entry_capacity;   // entries the list buffer holds: lists past it are not touched
     float saturation_epsilon; // convolution stops once every pixel's coverage is ≥ 1 − ε
     uint fragments_per_chunk; // see FRAGMENT_BUFFERS
-    uint pad1;
+    uint layers;           // depth layers stacked in the inputs and fragments (1 = visible only)
     uvec4 pass_u;          // pass-specific values (see each pass)
     vec4 pass_f;
 } frame;

@@ -246,6 +246,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         color: &frame.color,
         depth_m: &frame.depth_m,
         fov_y_deg: screen.fov_y_deg,
+        hidden_layers: &[],
     };
 
     let runs = if args.baseline { 2 } else { 1 };

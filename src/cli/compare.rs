@@ -68,6 +68,18 @@ pub struct CompareArgs {
     /// Skip the slice method.
     #[arg(long)]
     pub no_slices: bool,
+    /// The ground truth: `reference` (exact per-pixel PSFs, the same blend as splat) or
+    /// `views` (multi-view accumulation over the pupil: geometric optics, sees hidden
+    /// surfaces, shares neither kernels nor blend; the reference is then judged too).
+    #[arg(long, value_enum, default_value = "reference")]
+    pub truth: TruthArg,
+    /// Views over the pupil for --truth views (2–65536; default 256).
+    #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
+    pub views: Option<u32>,
+    /// Also judge splat over K depth-peeled layers ("splat-layers", 2–8; 1, the default,
+    /// adds no row). "splat" stays one layer.
+    #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
+    pub layers: Option<u32>,
     /// Write the results as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -82,6 +94,28 @@ pub struct CompareArgs {
     pub no_cache: bool,
 }
 
+/// Which image the others are judged against.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TruthArg {
+    Reference,
+    Views,
+}
+
+/// How far the views truth is from converged: the change when its views double (the even
+/// half against all of them), on the displayed image.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ViewsConvergence {
+    pub views: u32,
+    pub half_views: u32,
+    /// PSNR (dB) and MSSIM of the half-views image against the full one.
+    pub psnr_db: f64,
+    pub mssim: f64,
+    /// Largest change of a displayed channel value (0–1).
+    pub max_abs_change: f64,
+    pub seconds_raster: f64,
+    pub seconds_accumulate: f64,
+}
+
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct MethodResult {
     pub method: &'static str,
@@ -91,6 +125,11 @@ pub struct MethodResult {
     pub speedup_vs_reference: f64,
     /// GPU time of all passes (splat only).
     pub gpu_ms: Option<f64>,
+    /// Depth layers the method saw.
+    pub layers: u32,
+    /// Quality over the occlusion-edge band (pixels within the local blur radius of a depth
+    /// discontinuity).
+    pub edge_band: super::edge_band::BandQuality,
 }
 
 #[derive(serde::Serialize)]
@@ -102,8 +141,12 @@ struct Report {
     focus_d: f64,
     pupil_mm: f64,
     device: String,
+    /// `reference` or `views`.
+    truth: &'static str,
     /// What the ground truth shares with splat (what it cannot judge).
     truth_shares: &'static str,
+    /// The views truth's own convergence (null for the reference truth or --truth-in).
+    views_convergence: Option<ViewsConvergence>,
     methods: Vec<MethodResult>,
 }
 
@@ -112,6 +155,13 @@ const TRUTH_SHARES: &str = "ground truth: the exact PSF of every pixel's vergenc
 blend (depth groups), the pinhole's local layout and the PSFs with splat, so it judges splat's \
 kernel approximations (interpolation over distance and radius, merging, half-float texels), \
 not the blend or the optics";
+
+/// What the views truth has in common with the methods it judges.
+const VIEWS_SHARES: &str = "ground truth: multi-view accumulation over the pupil (geometric \
+optics, rasterised from each pupil point, each channel shifted by the eye's ray aberration); it \
+shares the scene, the focused eye and its Zernike coefficients per wavelength with splat, not \
+the kernels, the blend or the single visible layer; it leaves out diffraction, so it judges \
+where geometric blur dominates";
 
 /// The displayed image: linear values scaled by the exposure, clamped to [0, 1].
 fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
@@ -124,6 +174,9 @@ fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
 
 pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let splat = args.splat.settings()?;
+    if args.views.is_some() && args.truth != TruthArg::Views {
+        return Err(Error::input("--views applies to --truth views"));
+    }
     if args.slices == 0 {
         return Err(Error::input("--slices must be at least 1"));
     }
@@ -146,7 +199,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         outputs.add("--json", path, &["json"])?;
     }
     if let Some(dir) = &args.maps {
-        for name in map_names(args.no_slices) {
+        for name in map_names(
+            args.no_slices,
+            args.truth == TruthArg::Views,
+            args.layers.unwrap_or(crate::render::raster::DEFAULT_LAYERS) > 1,
+        ) {
             outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
         }
     }
@@ -173,6 +230,22 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         )
     })?;
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
+    let mut notes = Vec::new();
+    let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
+    for n in &notes {
+        println!("note: {n}");
+    }
+    let peeled = if layers > 1 {
+        crate::render::Rasterizer::new(&ctx)?.render_layers(
+            &ctx,
+            &scene.at_time(0.0),
+            args.size,
+            layers,
+            splat.blend.group_tolerance_d,
+        )?
+    } else {
+        Vec::new()
+    };
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     renderer.slice_count = args.slices;
     let input = FrameInput {
@@ -181,8 +254,14 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         color: &frame.color,
         depth_m: &frame.depth_m,
         fov_y_deg: screen.fov_y_deg,
+        hidden_layers: &[],
     };
 
+    let truth_method = match args.truth {
+        TruthArg::Reference => Method::Reference,
+        TruthArg::Views => Method::Views,
+    };
+    let mut convergence_images = None;
     let truth = match (&args.truth_in, truth_in) {
         (Some(path), Some(image)) => {
             if (image.width, image.height) != (width, height) {
@@ -195,17 +274,69 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             }
             RenderedFrame {
                 color: image.pixels,
-                method: Method::Reference,
+                method: truth_method,
                 seconds: f64::NAN,
+                timings: None,
+                stats: None,
+            }
+        }
+        _ if truth_method == Method::Views => {
+            let started = std::time::Instant::now();
+            let state = scene.at_time(0.0);
+            let column = crate::psf::defocus::ColumnOptics::new(
+                renderer.eye(),
+                pupil_mm,
+                focus_d,
+                renderer.kernels().grid.wavelengths_nm,
+                &options.settings,
+            )?;
+            let image = crate::render::views::render(
+                &ctx,
+                &mut crate::render::Rasterizer::new(&ctx)?,
+                &state,
+                (width, height),
+                &column,
+                focus_d,
+                args.views.unwrap_or(crate::render::views::DEFAULT_VIEWS),
+            )?;
+            let seconds = started.elapsed().as_secs_f64();
+            let color = image.color.clone();
+            convergence_images = Some(image);
+            RenderedFrame {
+                color,
+                method: Method::Views,
+                seconds,
                 timings: None,
                 stats: None,
             }
         }
         _ => renderer.render(&input, eye_state, Method::Reference)?,
     };
+    let reference_frame = if truth_method == Method::Views {
+        Some(renderer.render(&input, eye_state, Method::Reference)?)
+    } else {
+        None
+    };
     // The first splat frame compiles shaders and uploads the kernels: time the second.
     renderer.render(&input, eye_state, Method::Splat)?;
     let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
+    let layered_frame = if peeled.len() > 1 {
+        let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = peeled[1..]
+            .iter()
+            .map(|f| crate::render::splat::HiddenLayer {
+                color: &f.color,
+                depth_m: &f.depth_m,
+            })
+            .collect();
+        let layered = FrameInput {
+            hidden_layers: &hidden,
+            ..input
+        };
+        renderer.render(&layered, eye_state, Method::Splat)?;
+        Some(renderer.render(&layered, eye_state, Method::Splat)?)
+    } else {
+        None
+    };
     let slices_frame = if args.no_slices {
         None
     } else {
@@ -218,14 +349,58 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         Tonemap::auto_exposure_ev(&ImageRgba::new(width, height, frame.color.clone()));
     let scale = 2f32.powf(exposure_ev);
     let truth01 = exposed(&truth.color, scale);
+    let reference_seconds = reference_frame.as_ref().unwrap_or(&truth).seconds;
+    let views_convergence = convergence_images.as_ref().map(|image| {
+        let full = exposed(&image.color, scale);
+        let half = exposed(&image.half_color, scale);
+        let quality = ssim(
+            ImageView::new(w, h, &half),
+            ImageView::new(w, h, &full),
+            1.0,
+        );
+        let max_abs_change = half
+            .iter()
+            .zip(&full)
+            .flat_map(|(a, b)| (0..3).map(move |c| f64::from((a[c] - b[c]).abs())))
+            .fold(0.0, f64::max);
+        ViewsConvergence {
+            views: image.views,
+            half_views: image.views.div_ceil(2),
+            psnr_db: psnr(
+                ImageView::new(w, h, &half),
+                ImageView::new(w, h, &full),
+                1.0,
+            ),
+            mssim: quality.mean,
+            max_abs_change,
+            seconds_raster: image.seconds_raster,
+            seconds_accumulate: image.seconds_accumulate,
+        }
+    });
     let mut methods = Vec::new();
     let mut maps = Vec::new();
     let mut window_px = 11;
-    let frames: Vec<&RenderedFrame> = [Some(&truth), Some(&splat_frame), slices_frame.as_ref()]
-        .into_iter()
-        .flatten()
-        .collect();
-    for frame in frames.iter().copied() {
+    let frames: Vec<(&RenderedFrame, &'static str, u32)> = [
+        Some((&truth, truth_method.name(), 1)),
+        reference_frame.as_ref().map(|f| (f, "reference", 1)),
+        Some((&splat_frame, "splat", 1)),
+        layered_frame
+            .as_ref()
+            .map(|f| (f, "splat-layers", peeled.len() as u32)),
+        slices_frame.as_ref().map(|f| (f, "slices", 1)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let band = super::edge_band::edge_band(
+        &frame.depth_m,
+        (width, height),
+        screen.fov_y_deg,
+        &renderer.kernels().grid,
+        (pupil_mm, focus_d),
+        f64::from(splat.blend.group_tolerance_d),
+    );
+    for &(frame, name, frame_layers) in &frames {
         if let Some((count, first)) = non_finite(&frame.color, w) {
             return Err(Error::input(format!(
                 "the {} image has {count} pixels that are not finite (first at x = {}, y = {}); \
@@ -241,8 +416,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             ImageView::new(w, h, &truth01),
             1.0,
         );
+        let edge_band = super::edge_band::band_quality(&image, &truth01, &quality.map, &band, w);
         methods.push(MethodResult {
-            method: frame.method.name(),
+            method: name,
+            layers: frame_layers,
+            edge_band,
             seconds: frame.seconds,
             psnr_db: psnr(
                 ImageView::new(w, h, &image),
@@ -250,7 +428,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 1.0,
             ),
             mssim: quality.mean,
-            speedup_vs_reference: truth.seconds / frame.seconds.max(1e-12),
+            speedup_vs_reference: reference_seconds / frame.seconds.max(1e-12),
             gpu_ms: frame.timings.as_ref().map(|t| t.total_ms()),
         });
         maps.push(quality.map);
@@ -267,10 +445,28 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         args.eye,
         ctx.device_info().name
     );
-    println!("  {TRUTH_SHARES}");
+    let truth_shares = if truth_method == Method::Views {
+        VIEWS_SHARES
+    } else {
+        TRUTH_SHARES
+    };
+    println!("  {truth_shares}");
+    if let Some(c) = &views_convergence {
+        println!(
+            "  views: {} (doubling from {} changes the image by {:.2} dB PSNR, MSSIM {:.5}, at most {:.4})",
+            c.views, c.half_views, c.psnr_db, c.mssim, c.max_abs_change
+        );
+    }
     println!(
-        "  {:<10} {:>10} {:>10} {:>10} {:>12}",
-        "method", "PSNR dB", "MSSIM", "seconds", "× faster"
+        "  {:<13} {:>10} {:>10} {:>10} {:>12}   edge band ({} px): {:>8} {:>8}",
+        "method",
+        "PSNR dB",
+        "MSSIM",
+        "seconds",
+        "× faster",
+        methods.first().map_or(0, |m| m.edge_band.pixels),
+        "PSNR dB",
+        "MSSIM"
     );
     for m in &methods {
         let db = if m.psnr_db.is_infinite() {
@@ -278,9 +474,14 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         } else {
             format!("{:.2}", m.psnr_db)
         };
+        let band_db = if m.edge_band.psnr_db.is_infinite() {
+            "∞".to_string()
+        } else {
+            format!("{:.2}", m.edge_band.psnr_db)
+        };
         println!(
-            "  {:<10} {:>10} {:>10.4} {:>10.3} {:>12.1}",
-            m.method, db, m.mssim, m.seconds, m.speedup_vs_reference
+            "  {:<13} {:>10} {:>10.4} {:>10.3} {:>12.1}   {:>28} {:>8.4}",
+            m.method, db, m.mssim, m.seconds, m.speedup_vs_reference, band_db, m.edge_band.mssim
         );
     }
     if let Some(path) = &args.truth_out {
@@ -294,12 +495,9 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             exposure_ev,
             mode: TonemapMode::Clamp,
         };
-        for frame in &frames {
-            let name = match frame.method {
-                Method::Reference => "truth",
-                m => m.name(),
-            };
-            let image = ImageRgba::new(width, height, frame.color.clone());
+        for (i, frame) in frames.iter().enumerate() {
+            let name = if i == 0 { "truth" } else { frame.1 };
+            let image = ImageRgba::new(width, height, frame.0.color.clone());
             image_io::write_png(
                 outputs.temporary(&dir.join(format!("{name}.png"))),
                 &image,
@@ -310,7 +508,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             exposure_ev: 0.0,
             mode: TonemapMode::Clamp,
         };
-        for (name, map) in ["ssim_splat", "ssim_slices"].iter().zip(&maps[1..]) {
+        for (frame, map) in frames[1..].iter().zip(&maps[1..]) {
+            let name = format!("ssim_{}", frame.1);
             let rgb: Vec<[f32; 4]> = ssim_false_colour(map, 0.9)
                 .iter()
                 .map(|p| [0, 1, 2].map(|c| image_io::srgb_decode(p[c])))
@@ -332,7 +531,13 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             focus_d,
             pupil_mm,
             device: ctx.device_info().name.clone(),
-            truth_shares: TRUTH_SHARES,
+            truth: if truth_method == Method::Views {
+                "views"
+            } else {
+                "reference"
+            },
+            truth_shares,
+            views_convergence,
             methods,
         };
         let text = serde_json::to_string_pretty(&report)
@@ -356,12 +561,22 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
 }
 
 /// The files `--maps` writes, without extension.
-fn map_names(no_slices: bool) -> Vec<&'static str> {
-    if no_slices {
-        vec!["truth", "splat", "ssim_splat"]
-    } else {
-        vec!["truth", "splat", "slices", "ssim_splat", "ssim_slices"]
+fn map_names(no_slices: bool, views: bool, layers: bool) -> Vec<&'static str> {
+    let mut names = vec!["truth"];
+    let mut judged = vec![];
+    if views {
+        judged.push(("reference", "ssim_reference"));
     }
+    judged.push(("splat", "ssim_splat"));
+    if layers {
+        judged.push(("splat-layers", "ssim_splat-layers"));
+    }
+    if !no_slices {
+        judged.push(("slices", "ssim_slices"));
+    }
+    names.extend(judged.iter().map(|j| j.0));
+    names.extend(judged.iter().map(|j| j.1));
+    names
 }
 
 /// A `--maps` folder this run created, removed again (if still empty) unless kept.

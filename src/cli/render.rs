@@ -10,7 +10,7 @@ use super::raster::{parse_size, TonemapArg};
 use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+
 use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
 use crate::psf::cache::CacheOutcome;
@@ -135,9 +135,18 @@ pub struct RenderArgs {
     /// Scene time in seconds (keyframes).
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
     pub time: f64,
-    /// Rendering method.
+    /// Rendering method (views: scenes only).
     #[arg(long, value_enum, default_value = "splat")]
     pub method: Method,
+    /// Views over the pupil for --method views (2–65536; default 256). The image converges
+    /// as the views grow; compare --json reports the change when they double.
+    #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
+    pub views: Option<u32>,
+    /// Depth layers splat takes (1–8; default 1, see the README's measurements): a scene is
+    /// depth-peeled to K layers, a layered EXR gives its own (at most K; default all). Hidden
+    /// layers show through blurred edges; reference and slices use the visible layer only.
+    #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
+    pub layers: Option<u32>,
     #[command(flatten)]
     pub splat: super::SplatArgs,
     /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
@@ -210,20 +219,22 @@ fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 /// A frame to render, from a scene or from files.
-struct Input {
-    width: u32,
-    height: u32,
-    color: Vec<[f32; 4]>,
-    depth_m: Vec<f32>,
-    fov_y_deg: f64,
-    focus_m: Option<f64>,
-    pupil_mm: Option<f64>,
-    luminance_cdm2: Option<f64>,
-    label: String,
+pub(super) struct Input {
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) color: Vec<[f32; 4]>,
+    pub(super) depth_m: Vec<f32>,
+    pub(super) fov_y_deg: f64,
+    pub(super) focus_m: Option<f64>,
+    pub(super) pupil_mm: Option<f64>,
+    pub(super) luminance_cdm2: Option<f64>,
+    /// Hidden depth layers (colour, depth), nearest first.
+    pub(super) hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
+    pub(super) label: String,
     /// Where the depth came from, and what the depth policy found (file input).
-    depth_source: Option<String>,
-    depth_report: Option<crate::inputs::DepthReport>,
-    warnings: Vec<String>,
+    pub(super) depth_source: Option<String>,
+    pub(super) depth_report: Option<crate::inputs::DepthReport>,
+    pub(super) warnings: Vec<String>,
 }
 
 fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
@@ -256,6 +267,11 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
             label: file.color_source,
             depth_source: Some(file.depth_source),
             depth_report: Some(file.depth_report),
+            hidden: file
+                .hidden_layers
+                .into_iter()
+                .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
+                .collect(),
             warnings: file.warnings,
         });
     }
@@ -276,9 +292,24 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
         .size
         .unwrap_or((scene.resolution[0], scene.resolution[1]));
     let mut rasterizer = Rasterizer::new(ctx)?;
-    let frame = rasterizer.render(ctx, &state, width, height)?;
-    let mut depth_m = frame.depth_m;
     let mut warnings = Vec::new();
+    let k = if args.method == Method::Splat {
+        super::occlusion::scene_layers(ctx, args.layers, (width, height), &mut warnings)
+    } else {
+        1
+    };
+    let mut frames = rasterizer
+        .render_layers(
+            ctx,
+            &state,
+            (width, height),
+            k,
+            args.splat.blend.settings().group_tolerance_d,
+        )?
+        .into_iter();
+    let frame = frames.next().expect("layer 0");
+    let hidden = frames.map(|f| (f.color, f.depth_m)).collect();
+    let mut depth_m = frame.depth_m;
     let near = crate::render::focus::nearest_supported_m();
     let clamped = depth_m
         .iter_mut()
@@ -303,6 +334,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
         pupil_mm: state.pupil_mm,
         luminance_cdm2: state.luminance_cd_m2,
         label: format!("scene {name}"),
+        hidden,
         depth_source: None,
         depth_report: None,
         warnings,
@@ -401,7 +433,7 @@ fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
 fn mean_luminance(color: &[[f32; 4]]) -> f64 {
     let sum: f64 = color
         .iter()
-        .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
+        .map(|p| f64::from(crate::image_io::luminance([p[0], p[1], p[2]])))
         .sum();
     sum / color.len().max(1) as f64
 }
@@ -439,47 +471,6 @@ fn pupil_diameter(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
     Ok((mm, format!("{model} at {luminance:.3} cd/m² ({source})")))
 }
 
-#[derive(serde::Serialize)]
-struct Summary {
-    output: String,
-    input: String,
-    eye: String,
-    width: u32,
-    height: u32,
-    fov_y_deg: f64,
-    /// Where the depth came from (file input only).
-    depth: Option<String>,
-    /// Background, invalid, clamped and constant depth (file input only).
-    depth_report: Option<crate::inputs::DepthReport>,
-    /// The focus asked for (D; 0 = infinity).
-    focus_d: f64,
-    /// Where the eye actually focuses (D): `focus_d`, or its far (near) point when `focus_d`
-    /// lies beyond (nearer than) it (`focus_clamped`, `focus_limit`).
-    focus_reached_d: f64,
-    /// The same as `focus_reached_d` (the earlier name).
-    focus_actual_d: f64,
-    focus_clamped: bool,
-    focus_limit: crate::eye::FocusLimit,
-    #[serde(flatten)]
-    physiology: super::correction::Physiology,
-    pupil_mm: f64,
-    pupil_source: String,
-    /// Things about the input a user should know (also printed on stderr).
-    warnings: Vec<String>,
-    method: &'static str,
-    seconds_render: f64,
-    seconds_kernels: f64,
-    kernels_from_cache: bool,
-    psfs_computed: usize,
-    /// Worst pupil energy the kernels' PSFs missed, per (pupil, focus) column and channel
-    /// (null when the kernels came from the cache: they were checked when computed).
-    psf_missed_energy: Option<Vec<[f64; 3]>>,
-    max_radius_px: u32,
-    gpu_ms: Option<Vec<(String, f64)>>,
-    gpu_total_ms: Option<f64>,
-    device: String,
-}
-
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let output_ext = args
         .output
@@ -495,6 +486,20 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let splat = args.splat.settings()?;
     if let Some(fov) = args.fov_y {
         check_fov(fov)?;
+    }
+    if args.method == Method::Views && args.color.is_some() {
+        return Err(Error::input(
+            "--method views rasterises a scene from points across the pupil; it cannot render \
+             a --color frame (one view): give a scene",
+        ));
+    }
+    if args.views.is_some() && args.method != Method::Views {
+        return Err(Error::input("--views applies to --method views"));
+    }
+    if args.layers.is_some() && args.method != Method::Splat {
+        return Err(Error::input(
+            "--layers applies to --method splat (reference and slices see the visible layer only)",
+        ));
     }
     check_file_options(args)?;
     if let Some(ev) = args.exposure {
@@ -546,6 +551,28 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         &[state],
         screen,
     );
+    if args.method == Method::Views {
+        let scene = Scene::load(args.scene.as_deref().unwrap_or("primitives"))?;
+        let frame = super::occlusion::render_views(
+            &ctx,
+            &scene.at_time(args.time),
+            (input.width, input.height),
+            &eye,
+            (pupil_mm, focus_d),
+            args.views,
+            &options,
+        )?;
+        return super::render_output::finish(
+            args,
+            &ctx,
+            &input,
+            frame,
+            focus,
+            (focus_d, pupil_mm, pupil_source),
+            physiology,
+            None,
+        );
+    }
     let kernels = super::prepare_kernels(&eye, &needs, &options)?;
     let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
     let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
@@ -556,128 +583,40 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let seconds_kernels = kernels.seconds;
     let max_radius = kernels.grid.max_radius_px;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
+        .hidden
+        .iter()
+        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
+        .collect();
     let frame_input = FrameInput {
         width: input.width,
         height: input.height,
         color: &input.color,
         depth_m: &input.depth_m,
         fov_y_deg: input.fov_y_deg,
+        hidden_layers: if args.method == Method::Splat {
+            &hidden
+        } else {
+            &[]
+        },
     };
     let frame = renderer.render(&frame_input, state, args.method)?;
 
-    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
-    if output_ext.as_deref() == Some("exr") {
-        image_io::write_exr_rgba(&args.output, &image)?;
-    } else {
-        let mode = match args.tonemap {
-            TonemapArg::Clamp => TonemapMode::Clamp,
-            TonemapArg::Reinhard => TonemapMode::Reinhard,
-        };
-        // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
-        let exposure_ev = args.exposure.unwrap_or_else(|| {
-            Tonemap::auto_exposure_ev(&ImageRgba::new(
-                input.width,
-                input.height,
-                input.color.clone(),
-            ))
-        });
-        image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })?;
-    }
-    let gpu: Option<Vec<(String, f64)>> = frame
-        .timings
-        .as_ref()
-        .map(|t| t.passes.iter().map(|p| (p.name.clone(), p.ms)).collect());
-    let summary = Summary {
-        output: args.output.display().to_string(),
-        input: input.label.clone(),
-        eye: args.eye.clone(),
-        width: input.width,
-        height: input.height,
-        fov_y_deg: input.fov_y_deg,
-        depth: input.depth_source.clone(),
-        depth_report: input.depth_report.clone(),
-        focus_d,
-        focus_reached_d: focus.actual_d,
-        focus_actual_d: focus.actual_d,
-        focus_clamped: focus.clamped(),
-        focus_limit: focus.limit,
+    let info = super::render_output::KernelInfo {
+        from_cache,
+        psfs,
+        missed,
+        seconds: seconds_kernels,
+        max_radius,
+    };
+    super::render_output::finish(
+        args,
+        &ctx,
+        &input,
+        frame,
+        focus,
+        (focus_d, pupil_mm, pupil_source),
         physiology,
-        pupil_mm,
-        pupil_source,
-        warnings: input.warnings.clone(),
-        method: args.method.name(),
-        seconds_render: frame.seconds,
-        seconds_kernels,
-        kernels_from_cache: from_cache,
-        psfs_computed: psfs,
-        psf_missed_energy: missed,
-        max_radius_px: max_radius,
-        gpu_total_ms: frame.timings.as_ref().map(|t| t.total_ms()),
-        gpu_ms: gpu,
-        device: ctx.device_info().name.clone(),
-    };
-    if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&summary)
-                .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?
-        );
-        return Ok(());
-    }
-    let distance = |d: f64| {
-        if d > 0.0 {
-            format!("{:.3} m", 1.0 / d)
-        } else {
-            "infinity".into()
-        }
-    };
-    let focus = match focus.limit {
-        crate::eye::FocusLimit::Reached => distance(focus_d),
-        crate::eye::FocusLimit::FarPoint => format!(
-            "{} (its far point; asked {}, beyond it)",
-            distance(focus.actual_d),
-            distance(focus_d)
-        ),
-        crate::eye::FocusLimit::NearPoint => format!(
-            "{} (its near point, clamped; asked {}, nearer)",
-            distance(focus.actual_d),
-            distance(focus_d)
-        ),
-    };
-    let through = summary
-        .physiology
-        .correction
-        .as_ref()
-        .map(|c| format!(" through {c}"))
-        .unwrap_or_default();
-    let focus = format!("{focus}{through}");
-    println!(
-        "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
-        summary.output,
-        input.width,
-        input.height,
-        input.label,
-        args.eye,
-        pupil_mm,
-        summary.pupil_source,
-        args.method.name(),
-        frame.seconds,
-        if from_cache { "from cache".to_string() } else { format!("{psfs} PSFs in {seconds_kernels:.1} s") }
-    );
-    if args.timings {
-        if let Some(t) = &frame.timings {
-            for p in &t.passes {
-                println!("  {:<12} {:>9.3} ms", p.name, p.ms);
-            }
-            println!(
-                "  {:<12} {:>9.3} ms  (GPU, {})",
-                "total",
-                t.total_ms(),
-                summary.device
-            );
-        } else {
-            println!("  (--timings applies to --method splat)");
-        }
-    }
-    Ok(())
+        Some(info),
+    )
 }

@@ -523,6 +523,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             color: &frame.color,
             depth_m: &frame.depth_m,
             fov_y_deg: state.camera.fov_y_deg,
+            hidden_layers: &[],
         };
         let mut panels = Vec::new();
         for renderer in renderers.iter_mut() {

@@ -4,6 +4,7 @@
 
 pub mod depth;
 pub mod exr;
+pub mod layered;
 pub mod picture;
 
 use std::path::{Path, PathBuf};
@@ -42,6 +43,9 @@ pub struct FileInput {
     pub depth_report: DepthReport,
     /// Lines for stderr and the JSON summary, each starting with the file it concerns.
     pub warnings: Vec<String>,
+    /// Hidden layers (colour, depth in metres; +∞ where empty) of a layered EXR, nearest
+    /// first; empty for any other input.
+    pub hidden_layers: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -93,6 +97,11 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
         Kind::Exr => Some(exr::ExrChannels::read(&options.color)?),
         Kind::Picture => None,
     };
+    if let Some(file) = &color_exr {
+        if let Some(layers) = layered::read_layers(&options.color, file)? {
+            return load_layered(options, layers);
+        }
+    }
     let (mut color, color_source, color_layer) = match &color_exr {
         Some(file) => {
             let (mut image, group) = file.color(&options.color, options.color_layer.as_deref())?;
@@ -184,6 +193,81 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
         depth_source: format!("{} ({})", depth_path.display(), raw.channel),
         depth_report: report,
         warnings,
+        hidden_layers: Vec::new(),
+    })
+}
+
+/// A layered EXR (parts `layer0`, `layer1`, …): layer 0 is the frame, the rest hidden layers.
+fn load_layered(
+    options: &FileInputOptions,
+    (width, height, layers): (u32, u32, Vec<layered::RawLayer>),
+) -> Result<FileInput> {
+    let path = &options.color;
+    if let Some(depth) = &options.depth {
+        if depth != path {
+            return Err(Error::input(format!(
+                "--depth {}: {} is a layered EXR (parts layer0, layer1, …) holding its own depth; \
+                 give it as --depth too, or leave --depth out",
+                depth.display(),
+                path.display()
+            )));
+        }
+    }
+    for (given, name) in [
+        (options.color_layer.is_some(), "--color-layer"),
+        (options.depth_channel.is_some(), "--depth-channel"),
+    ] {
+        if given {
+            return Err(Error::input(format!(
+                "{name} does not apply to the layered EXR {} (parts layer0, layer1, … with R, G, \
+                 B, Z each)",
+                path.display()
+            )));
+        }
+    }
+    let white = options.white_cdm2.unwrap_or(1.0) as f32;
+    let mut warnings = Vec::new();
+    let mut layers = layers.into_iter();
+    let first = layers.next().expect("layer0 is there");
+    let mut color = ImageRgba::new(
+        width,
+        height,
+        first
+            .color
+            .iter()
+            .map(|c| [c[0] * white, c[1] * white, c[2] * white, 1.0])
+            .collect(),
+    );
+    if let Some(w) = check_finite_color(path, &mut color, options.repair_nonfinite)? {
+        warnings.push(w);
+    }
+    let (depth_m, report) = depth::apply(&first.z, width, first.half, options.depth_scale);
+    for w in report.warnings() {
+        warnings.push(format!("{}: {w}", path.display()));
+    }
+    let mut hidden_layers = Vec::new();
+    for (k, mut layer) in layers.enumerate() {
+        for c in &mut layer.color {
+            for v in &mut c[..3] {
+                *v *= white;
+            }
+        }
+        hidden_layers.push(layered::hidden_layer(
+            path,
+            k + 1,
+            layer,
+            width,
+            options.depth_scale,
+        )?);
+    }
+    Ok(FileInput {
+        color,
+        depth_m,
+        color_source: format!("{} (layer0 of {})", path.display(), 1 + hidden_layers.len()),
+        depth_source: format!("{} (layer0.Z)", path.display()),
+        depth_report: report,
+        warnings,
+        hidden_layers,
     })
 }
 

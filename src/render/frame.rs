@@ -27,6 +27,9 @@ pub enum Method {
     Reference,
     /// Depth slices convolved with their centre PSF (the classic previous method).
     Slices,
+    /// Multi-view accumulation over the pupil (geometric optics, sees hidden surfaces; scenes
+    /// only).
+    Views,
 }
 
 impl Method {
@@ -35,6 +38,7 @@ impl Method {
             Method::Splat => "splat",
             Method::Reference => "reference",
             Method::Slices => "slices",
+            Method::Views => "views",
         }
     }
 }
@@ -214,6 +218,10 @@ impl FrameRenderer {
         }
     }
 
+    pub fn eye(&self) -> &Eye {
+        &self.eye
+    }
+
     pub fn kernels(&self) -> &PreparedKernels {
         &self.kernels
     }
@@ -233,6 +241,10 @@ impl FrameRenderer {
         }
         let started = Instant::now();
         match method {
+            Method::Views => Err(Error::input(
+                "--method views rasterises a scene from points across the pupil: it needs a \
+                 scene, not a colour + depth frame",
+            )),
             Method::Splat => {
                 if self.splatter.is_none() {
                     self.splatter = Some(Splatter::new(

@@ -9,5 +9,6 @@ pub mod raster;
 pub mod reference;
 pub mod slices;
 pub mod splat;
+pub mod views;
 
 pub use raster::{Frame, Rasterizer, MSAA_SAMPLES};

@@ -20,6 +20,9 @@ use crate::{Error, Result};
 /// Samples per pixel.
 pub const MSAA_SAMPLES: u32 = 4;
 
+/// Depth layers a scene is peeled to for splat unless told otherwise (README: measured).
+pub const DEFAULT_LAYERS: u32 = 1;
+
 /// A rendered frame on the CPU: row-major, top row first.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -94,10 +97,14 @@ struct Targets {
     view_depth_ms: Image,
     color: Image,
     framebuffer: Framebuffer,
+    /// The same targets for the peeling pipeline, and the previous layer's depth it reads.
+    peel_framebuffer: Framebuffer,
+    previous_depth: Image,
 }
 
 pub struct Rasterizer {
     pipeline: GraphicsPipeline,
+    peel: GraphicsPipeline,
     resolve: ComputePipeline,
     texture_sampler: Sampler,
     point_sampler: Sampler,
@@ -108,39 +115,8 @@ pub struct Rasterizer {
 
 impl Rasterizer {
     pub fn new(ctx: &Context) -> Result<Rasterizer> {
-        let stride = std::mem::size_of::<Vertex>() as u32;
-        let pipeline = GraphicsPipeline::builder(
-            "raster",
-            crate::shaders::RENDER_RASTER_VERT,
-            crate::shaders::RENDER_RASTER_FRAG,
-        )
-        .vertex_layout(
-            stride,
-            &[
-                VertexAttribute {
-                    location: 0,
-                    format: VertexFormat::Float3,
-                    offset: 0,
-                },
-                VertexAttribute {
-                    location: 1,
-                    format: VertexFormat::Float3,
-                    offset: 12,
-                },
-                VertexAttribute {
-                    location: 2,
-                    format: VertexFormat::Float2,
-                    offset: 24,
-                },
-            ],
-        )
-        .bindings(&[BindingKind::UniformBuffer, BindingKind::SampledImage])
-        .push_constants::<MaterialPush>()
-        .samples(MSAA_SAMPLES)
-        .color_target(TexelFormat::Rgba32Float, true)
-        .color_target(TexelFormat::R32Float, false)
-        .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
-        .build(ctx)?;
+        let pipeline = Self::pipeline(ctx, false)?;
+        let peel = Self::pipeline(ctx, true)?;
         let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
             .bindings(&[BindingKind::SampledImage, BindingKind::StorageBuffer])
             .push_constants::<ResolvePush>()
@@ -156,6 +132,7 @@ impl Rasterizer {
         white.upload(ctx, &[[255u8; 4]])?;
         Ok(Rasterizer {
             pipeline,
+            peel,
             resolve,
             texture_sampler: Sampler::linear(ctx, Edge::Repeat)?,
             point_sampler: Sampler::linear(ctx, Edge::ClampToEdge)?,
@@ -163,6 +140,56 @@ impl Rasterizer {
             scene: None,
             targets: None,
         })
+    }
+
+    /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
+    /// layer's depth).
+    fn pipeline(ctx: &Context, peel: bool) -> Result<GraphicsPipeline> {
+        let stride = std::mem::size_of::<Vertex>() as u32;
+        let (name, fragment) = if peel {
+            ("raster peel", crate::shaders::RENDER_RASTER_PEEL_FRAG)
+        } else {
+            ("raster", crate::shaders::RENDER_RASTER_FRAG)
+        };
+        let bindings: &[BindingKind] = if peel {
+            &[
+                BindingKind::UniformBuffer,
+                BindingKind::SampledImage,
+                BindingKind::SampledImage,
+            ]
+        } else {
+            &[BindingKind::UniformBuffer, BindingKind::SampledImage]
+        };
+        Ok(
+            GraphicsPipeline::builder(name, crate::shaders::RENDER_RASTER_VERT, fragment)
+                .vertex_layout(
+                    stride,
+                    &[
+                        VertexAttribute {
+                            location: 0,
+                            format: VertexFormat::Float3,
+                            offset: 0,
+                        },
+                        VertexAttribute {
+                            location: 1,
+                            format: VertexFormat::Float3,
+                            offset: 12,
+                        },
+                        VertexAttribute {
+                            location: 2,
+                            format: VertexFormat::Float2,
+                            offset: 24,
+                        },
+                    ],
+                )
+                .bindings(bindings)
+                .push_constants::<MaterialPush>()
+                .samples(MSAA_SAMPLES)
+                .color_target(TexelFormat::Rgba32Float, true)
+                .color_target(TexelFormat::R32Float, false)
+                .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
+                .build(ctx)?,
+        )
     }
 
     fn upload_scene(&mut self, ctx: &Context, state: &FrameState<'_>) -> Result<()> {
@@ -258,9 +285,25 @@ impl Rasterizer {
             &[&color],
             Some(&depth_ms),
         )?;
+        let peel_framebuffer = self.peel.framebuffer(
+            ctx,
+            &[&color_ms, &view_depth_ms],
+            &[&color],
+            Some(&depth_ms),
+        )?;
+        let previous_depth = Image::new_2d(
+            ctx,
+            "raster previous layer depth",
+            width,
+            height,
+            TexelFormat::R32Float,
+            ImageUsage::SAMPLED,
+        )?;
         self.targets = Some(Targets {
             width,
             height,
+            peel_framebuffer,
+            previous_depth,
             color_ms,
             depth_ms,
             view_depth_ms,
@@ -278,6 +321,82 @@ impl Rasterizer {
         width: u32,
         height: u32,
     ) -> Result<Frame> {
+        let camera = &state.camera;
+        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
+        let view_proj = projection * camera.view_matrix();
+        self.render_from(ctx, state, width, height, view_proj, camera.position_m)
+    }
+
+    /// Renders `state` through `view_proj` (world → clip) seen from `eye_position_m` (where
+    /// view-dependent shading looks from), e.g. an off-axis frustum from a point on the pupil.
+    /// Depth stays the distance along the camera's own view axis.
+    pub fn render_from(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        width: u32,
+        height: u32,
+        view_proj: glam::DMat4,
+        eye_position_m: [f64; 3],
+    ) -> Result<Frame> {
+        self.draw(ctx, state, (width, height), view_proj, eye_position_m, None)
+    }
+
+    /// The first `layers` surfaces along each pixel's ray (depth peeling), nearest first.
+    /// Layer 0 is [`Rasterizer::render`]'s frame; in the others a pixel with no surface has
+    /// colour 0 and depth +∞, and a surface lies behind the previous layer's by more than
+    /// `gap_d` dioptres (the blend's depth-group tolerance) and faces the eye. Edge pixels
+    /// hold the hidden surface's own colour (coverage divided out).
+    pub fn render_layers(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        (width, height): (u32, u32),
+        layers: u32,
+        gap_d: f32,
+    ) -> Result<Vec<Frame>> {
+        let camera = &state.camera;
+        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
+        let view_proj = projection * camera.view_matrix();
+        let mut frames = vec![self.render(ctx, state, width, height)?];
+        for _ in 1..layers {
+            let previous = &frames.last().expect("layer 0 is there").depth_m;
+            // layer 0's background (the far plane) hides nothing
+            let far = camera.far_m as f32;
+            let previous: Vec<f32> = previous
+                .iter()
+                .map(|&d| if d >= far { f32::INFINITY } else { d })
+                .collect();
+            let mut frame = self.draw(
+                ctx,
+                state,
+                (width, height),
+                view_proj,
+                camera.position_m,
+                Some((&previous, gap_d)),
+            )?;
+            for (c, d) in frame.color.iter_mut().zip(frame.depth_m.iter_mut()) {
+                if c[3] > 1e-6 && *d < far {
+                    *c = [c[0] / c[3], c[1] / c[3], c[2] / c[3], 1.0];
+                } else {
+                    *c = [0.0; 4];
+                    *d = f32::INFINITY;
+                }
+            }
+            frames.push(frame);
+        }
+        Ok(frames)
+    }
+
+    fn draw(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        (width, height): (u32, u32),
+        view_proj: glam::DMat4,
+        eye_position_m: [f64; 3],
+        peel: Option<(&[f32], f32)>,
+    ) -> Result<Frame> {
         if width == 0 || height == 0 {
             return Err(Error::input(format!(
                 "frame size {width}×{height} has no pixels"
@@ -289,14 +408,13 @@ impl Rasterizer {
         let camera = &state.camera;
 
         let view = camera.view_matrix();
-        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
         let mut uniform = FrameUniform {
-            view_proj: (projection * view).as_mat4().to_cols_array_2d(),
+            view_proj: view_proj.as_mat4().to_cols_array_2d(),
             view: view.as_mat4().to_cols_array_2d(),
             camera_position: [
-                camera.position_m[0] as f32,
-                camera.position_m[1] as f32,
-                camera.position_m[2] as f32,
+                eye_position_m[0] as f32,
+                eye_position_m[1] as f32,
+                eye_position_m[2] as f32,
                 1.0,
             ],
             ambient: [0.0; 4],
@@ -331,6 +449,11 @@ impl Rasterizer {
             }
         }
         uniform.counts[0] = count as u32;
+        let bg = scene.background_rgb;
+        // the peeling shader reads its gap from the otherwise unused ambient.w
+        if let Some((_, gap_d)) = peel {
+            uniform.ambient[3] = gap_d;
+        }
         let mut uniform_buffer = Buffer::new(
             ctx,
             "raster frame uniforms",
@@ -358,17 +481,22 @@ impl Rasterizer {
 
         let gpu_scene = self.scene.as_ref().expect("uploaded above");
         let targets = self.targets.as_ref().expect("created above");
-        let bg = scene.background_rgb;
+        if let Some((previous, _)) = peel {
+            targets.previous_depth.upload(ctx, previous)?;
+        }
+        let (pipeline, framebuffer, clear) = match peel {
+            None => (
+                &self.pipeline,
+                &targets.framebuffer,
+                [bg[0], bg[1], bg[2], 1.0],
+            ),
+            Some(_) => (&self.peel, &targets.peel_framebuffer, [0.0; 4]),
+        };
         let far = camera.far_m as f32;
         let materials = &scene.geometry.materials;
         let timings = ctx.submit(|rec| {
             rec.begin_pass("raster");
-            rec.begin_render_pass(
-                &self.pipeline,
-                &targets.framebuffer,
-                &[[bg[0], bg[1], bg[2], 1.0], [far, 0.0, 0.0, 0.0]],
-                0.0,
-            )?;
+            rec.begin_render_pass(pipeline, framebuffer, &[clear, [far, 0.0, 0.0, 0.0]], 0.0)?;
             for batch in &scene.geometry.batches {
                 let material = &materials[batch.material];
                 let texture = material
@@ -389,12 +517,15 @@ impl Rasterizer {
                         0.0,
                     ],
                 };
+                let previous = Binding::Sampled(&targets.previous_depth, &self.point_sampler);
+                let bindings = [
+                    Binding::Buffer(&uniform_buffer),
+                    Binding::Sampled(texture, &self.texture_sampler),
+                    previous,
+                ];
                 rec.draw_indexed(
-                    &self.pipeline,
-                    &[
-                        Binding::Buffer(&uniform_buffer),
-                        Binding::Sampled(texture, &self.texture_sampler),
-                    ],
+                    pipeline,
+                    &bindings[..if peel.is_some() { 3 } else { 2 }],
                     &push,
                     &gpu_scene.vertices,
                     &gpu_scene.indices,

@@ -14,12 +14,15 @@ FRAGMENT_BUFFERS(3, 4, 5, 6, writeonly)
 FRAGMENT_STORE
 
 void main() {
-    uvec2 p = gl_GlobalInvocationID.xy;
-    if (p.x >= frame.width || p.y >= frame.height) {
+    uvec2 g = gl_GlobalInvocationID.xy;
+    if (g.x >= frame.width || g.y >= frame.height * frame.layers) {
         return;
     }
-    vec3 color = imageLoad(color_in, ivec2(p)).rgb;
-    float depth = imageLoad(depth_in, ivec2(p)).r;
+    // Layers are stacked downwards: row g.y is row p.y of layer g.y / height.
+    uint layer = g.y / frame.height;
+    uvec2 p = uvec2(g.x, g.y - layer * frame.height);
+    vec3 color = imageLoad(color_in, ivec2(g)).rgb;
+    float depth = imageLoad(depth_in, ivec2(g)).r;
     // Infinite, missing or non-positive depth is optical infinity (0 D). Depth is along the
     // view axis; light reaches the eye with the vergence of the distance along the ray.
     bool finite_depth = depth > 0.0 && !isinf(depth) && !isnan(depth);
@@ -39,7 +42,27 @@ void main() {
     f.radius = min(radius, vec3(float(frame.max_radius)));
     f.index = index;
     f.center = vec2(p) + 0.5;
-    f.size = 1u;
+    // A hidden layer is empty where its depth is infinite: no fragment (the visible layer's
+    // infinite depth is the background at optical infinity).
+    f.size = layer > 0u && !finite_depth ? 0u : 1u;
+    if (layer > 0u && f.size != 0u) {
+        // Near the frame's border the visible layer's coverage falls short because nothing
+        // lies beyond the frame, not because its edge lets light by: a hidden fragment there
+        // would fill that gap with what no pupil point sees (e.g. geometry under a floor).
+        // Keep it only farther from the border than the visible surface's own blur radius.
+        float d0 = imageLoad(depth_in, ivec2(p)).r;
+        bool finite0 = d0 > 0.0 && !isinf(d0) && !isnan(d0);
+        float v0 = finite0 ? 1.0 / (d0 * ray) : 0.0;
+        float i0f = clamp((v0 - frame.dioptre_min) / frame.dioptre_step, 0.0, last);
+        uint j0 = uint(floor(i0f));
+        uint j1 = min(j0 + 1u, frame.object_count - 1u);
+        float r0 = min(max(mix(radii[j0].y, radii[j1].y, i0f - float(j0)), 0.0), float(frame.max_radius));
+        vec2 c = vec2(p) + 0.5;
+        float border = min(min(c.x, float(frame.width) - c.x), min(c.y, float(frame.height) - c.y));
+        if (border < r0 + 1.0) {
+            f.size = 0u;
+        }
+    }
     f.dioptre = dioptre;
-    store_fragment(p.y * frame.width + p.x, f);
+    store_fragment(g.y * frame.width + g.x, f);
 }

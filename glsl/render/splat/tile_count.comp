@@ -16,7 +16,7 @@ void main() {
     if (gl_LocalInvocationIndex == 0u) live_in_group = 0u;
     barrier();
     uvec2 p = gl_GlobalInvocationID.xy;
-    if (p.x < frame.width && p.y < frame.height) {
+    if (p.x < frame.width && p.y < frame.height * frame.layers) {
         Fragment f = load_fragment(p.y * frame.width + p.x);
         if (f.size != 0u) {
             atomicAdd(live_in_group, 1u);

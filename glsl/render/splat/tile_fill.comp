@@ -15,7 +15,7 @@ layout(std430, binding = 3) writeonly buffer Entries { uvec2 entries[]; };
 
 void main() {
     uvec2 p = gl_GlobalInvocationID.xy;
-    if (p.x >= frame.width || p.y >= frame.height) {
+    if (p.x >= frame.width || p.y >= frame.height * frame.layers) {
         return;
     }
     uint index = p.y * frame.width + p.x;

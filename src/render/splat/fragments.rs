@@ -138,7 +138,11 @@ impl FragmentsPass {
                 &[],
             ),
             params,
-            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+            [
+                params.width.div_ceil(8),
+                (params.height * params.layers).div_ceil(8),
+                1,
+            ],
         )
     }
 }

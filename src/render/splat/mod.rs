@@ -68,7 +68,8 @@ pub(crate) struct FrameParams {
     pub saturation_epsilon: f32,
     /// Fragments per bound range of the fragment buffer (`fragments::FragmentStore`).
     pub fragments_per_chunk: u32,
-    pub pad: u32,
+    /// Depth layers stacked in the inputs and the fragment buffer (1 = the visible surface).
+    pub layers: u32,
     pub pass_u: [u32; 4],
     pub pass_f: [f32; 4],
 }
@@ -180,6 +181,16 @@ pub struct FrameInput<'a> {
     pub depth_m: &'a [f32],
     /// Vertical field of view of the pinhole camera that made the frame (degrees).
     pub fov_y_deg: f64,
+    /// The 2nd, 3rd, … surfaces along each pixel's ray (depth peeling, layered EXR), nearest
+    /// first; infinite depth where a layer is empty. Empty: the visible surface only.
+    pub hidden_layers: &'a [HiddenLayer<'a>],
+}
+
+/// One hidden depth layer of a frame: the same layout as the visible one.
+#[derive(Clone, Copy, Debug)]
+pub struct HiddenLayer<'a> {
+    pub color: &'a [[f32; 4]],
+    pub depth_m: &'a [f32],
 }
 
 impl FrameInput<'_> {
@@ -238,6 +249,7 @@ pub struct SplatOutput {
 struct FrameResources {
     width: u32,
     height: u32,
+    layers: u32,
     tiles_x: u32,
     tiles_y: u32,
     color_in: Image,
@@ -290,6 +302,12 @@ const ENTRY_BYTES: u64 = 8;
 
 fn binding_limit(ctx: &Context) -> u64 {
     u64::from(ctx.limits().max_storage_buffer_range)
+}
+
+/// Most depth layers whose fragments fit one storage-buffer binding at `width`×`height`.
+pub fn max_layers(ctx: &Context, width: u32, height: u32) -> u32 {
+    let per_layer = u64::from(width) * u64::from(height) * FRAGMENT_BYTES;
+    (binding_limit(ctx) / per_layer.max(1)).min(u64::from(u32::MAX)) as u32
 }
 
 impl Splatter {
@@ -360,21 +378,23 @@ impl Splatter {
         (&self.texture, &self.sampler)
     }
 
-    fn ensure_frame(&mut self, width: u32, height: u32) -> crate::Result<()> {
+    fn ensure_frame(&mut self, width: u32, height: u32, layers: u32) -> crate::Result<()> {
         if self
             .frame
             .as_ref()
-            .is_some_and(|f| f.width == width && f.height == height)
+            .is_some_and(|f| f.width == width && f.height == height && f.layers == layers)
         {
             return Ok(());
         }
         let ctx = &self.ctx;
-        let pixels = u64::from(width) * u64::from(height);
+        // every layer's pixels: the inputs and fragments are stacked layer under layer
+        let pixels = u64::from(width) * u64::from(height) * u64::from(layers);
         let limit = binding_limit(ctx).min(self.settings.max_fragment_binding_bytes);
         let Some(per_chunk) = fragments::fragments_per_chunk(pixels, limit) else {
             return Err(crate::Error::input(format!(
-                "a {width}×{height} frame needs {} MiB of fragments, over four of this device's {} MiB \
-                 storage-buffer bindings; render at most {} pixels per frame on this device",
+                "a {width}×{height} frame with {layers} depth layer(s) needs {} MiB of fragments, over \
+                 four of this device's {} MiB storage-buffer bindings; render at most {} pixels (all \
+                 layers) per frame on this device",
                 (pixels * FRAGMENT_BYTES) >> 20,
                 limit >> 20,
                 fragments::FRAGMENT_CHUNKS * (limit / FRAGMENT_BYTES)
@@ -387,13 +407,14 @@ impl Splatter {
         self.frame = Some(FrameResources {
             width,
             height,
+            layers,
             tiles_x,
             tiles_y,
             color_in: Image::new_2d(
                 ctx,
                 "input colour",
                 width,
-                height,
+                height * layers,
                 TexelFormat::Rgba32Float,
                 storage,
             )?,
@@ -401,7 +422,7 @@ impl Splatter {
                 ctx,
                 "input depth",
                 width,
-                height,
+                height * layers,
                 TexelFormat::R32Float,
                 storage,
             )?,
@@ -430,7 +451,12 @@ impl Splatter {
                 Residency::Upload,
             )?,
             staging_depth: Buffer::new(ctx, "input depth staging", pixels * 4, Residency::Upload)?,
-            readback_color: Buffer::new(ctx, "output read-back", pixels * 16, Residency::Readback)?,
+            readback_color: Buffer::new(
+                ctx,
+                "output read-back",
+                pixels / u64::from(layers) * 16,
+                Residency::Readback,
+            )?,
             readback_lists: Buffer::new(
                 ctx,
                 "list sizes read-back",
@@ -454,7 +480,7 @@ impl Splatter {
             tile_size: self.settings.tile_size,
             object_count: self.grid.objects.count as u32,
             max_radius: self.grid.max_radius_px,
-            fragment_count: frame.width * frame.height,
+            fragment_count: frame.width * frame.height * frame.layers,
             dioptre_min: self.grid.objects.min_d as f32,
             dioptre_step: self.grid.objects.step_d as f32,
             merge_min_radius: merge.min_radius_px,
@@ -473,7 +499,7 @@ impl Splatter {
             entry_capacity: 0,
             saturation_epsilon: self.settings.saturation_epsilon,
             fragments_per_chunk: frame.fragments.per_chunk,
-            pad: 0,
+            layers: frame.layers,
             pass_u: [0; 4],
             pass_f: [0.0; 4],
         }
@@ -506,7 +532,18 @@ impl Splatter {
         }
         let allocations_before = self.allocations;
         let objects_before = self.ctx.submission_objects_created();
-        self.ensure_frame(w, h)?;
+        for (k, layer) in input.hidden_layers.iter().enumerate() {
+            if layer.color.len() != pixels || layer.depth_m.len() != pixels {
+                return Err(crate::Error::input(format!(
+                    "hidden layer {} of a {w}×{h} frame needs {pixels} colour and depth values \
+                     (got {} and {})",
+                    k + 1,
+                    layer.color.len(),
+                    layer.depth_m.len()
+                )));
+            }
+        }
+        self.ensure_frame(w, h, 1 + input.hidden_layers.len() as u32)?;
         let ctx = self.ctx.clone();
         let blend = self.grid.blend(view.pupil_mm, view.focus_d);
         // xyz: natural radius per channel; w: the smallest core radius over the channels,
@@ -524,9 +561,14 @@ impl Splatter {
             let frame = self.frame.as_mut().expect("ensured above");
             write_mapped(&mut frame.staging_color, input.color);
             write_mapped(&mut frame.staging_depth, input.depth_m);
+            for (k, layer) in input.hidden_layers.iter().enumerate() {
+                write_mapped_at(&mut frame.staging_color, (k + 1) * pixels, layer.color);
+                write_mapped_at(&mut frame.staging_depth, (k + 1) * pixels, layer.depth_m);
+            }
             write_mapped(&mut self.radii_staging, &radii);
         }
-        let upload_bytes = (pixels * 20 + radii.len() * 16) as u64;
+        let upload_bytes =
+            (pixels * 20 * (1 + input.hidden_layers.len()) + radii.len() * 16) as u64;
         let frame = self.frame.as_ref().expect("ensured above");
         let mut params = self.params(frame);
         params.focal_px = input.projection().focal_px() as f32;
@@ -876,6 +918,16 @@ fn write_mapped<T: bytemuck::Pod>(buffer: &mut Buffer, data: &[T]) {
     buffer
         .mapped_bytes_mut()
         .expect("upload buffers are host-visible")[..bytes.len()]
+        .copy_from_slice(bytes);
+}
+
+/// Writes `data` into a mapped buffer starting at element `offset` (elements of `T`).
+fn write_mapped_at<T: bytemuck::Pod>(buffer: &mut Buffer, offset: usize, data: &[T]) {
+    let size = std::mem::size_of::<T>();
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    buffer
+        .mapped_bytes_mut()
+        .expect("upload buffers are host-visible")[offset * size..offset * size + bytes.len()]
         .copy_from_slice(bytes);
 }
 

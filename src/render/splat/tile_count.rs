@@ -32,7 +32,11 @@ impl TileCountPass {
             &self.pipeline,
             &fragments.bind_with(&[], &[Binding::Buffer(counts)]),
             params,
-            [params.width.div_ceil(8), params.height.div_ceil(8), 1],
+            [
+                params.width.div_ceil(8),
+                (params.height * params.layers).div_ceil(8),
+                1,
+            ],
         )
     }
 }

@@ -1,0 +1,201 @@
+//! `ocular render`'s output: the image file and the summary (text or JSON).
+
+use super::raster::TonemapArg;
+use super::render::{Input, RenderArgs};
+use crate::gpu::Context;
+use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::render::frame::Method;
+use crate::{Error, Result};
+
+#[derive(serde::Serialize)]
+pub(super) struct Summary {
+    output: String,
+    input: String,
+    eye: String,
+    width: u32,
+    height: u32,
+    fov_y_deg: f64,
+    /// Where the depth came from (file input only).
+    depth: Option<String>,
+    /// Background, invalid, clamped and constant depth (file input only).
+    depth_report: Option<crate::inputs::DepthReport>,
+    /// The focus asked for (D; 0 = infinity).
+    focus_d: f64,
+    /// Where the eye actually focuses (D): `focus_d`, or its far (near) point when `focus_d`
+    /// lies beyond (nearer than) it (`focus_clamped`, `focus_limit`).
+    focus_reached_d: f64,
+    /// The same as `focus_reached_d` (the earlier name).
+    focus_actual_d: f64,
+    focus_clamped: bool,
+    focus_limit: crate::eye::FocusLimit,
+    #[serde(flatten)]
+    physiology: super::correction::Physiology,
+    pupil_mm: f64,
+    pupil_source: String,
+    /// Things about the input a user should know (also printed on stderr).
+    warnings: Vec<String>,
+    method: &'static str,
+    seconds_render: f64,
+    seconds_kernels: f64,
+    kernels_from_cache: bool,
+    psfs_computed: usize,
+    /// Worst pupil energy the kernels' PSFs missed, per (pupil, focus) column and channel
+    /// (null when the kernels came from the cache: they were checked when computed).
+    psf_missed_energy: Option<Vec<[f64; 3]>>,
+    max_radius_px: u32,
+    gpu_ms: Option<Vec<(String, f64)>>,
+    gpu_total_ms: Option<f64>,
+    device: String,
+}
+
+/// How the kernels of a splat, reference or slices frame were obtained.
+pub(super) struct KernelInfo {
+    pub(super) from_cache: bool,
+    pub(super) psfs: usize,
+    pub(super) missed: Option<Vec<[f64; 3]>>,
+    pub(super) seconds: f64,
+    pub(super) max_radius: u32,
+}
+
+/// Writes the output and prints the summary.
+pub(super) fn finish(
+    args: &RenderArgs,
+    ctx: &Context,
+    input: &Input,
+    frame: crate::render::frame::RenderedFrame,
+    focus: crate::render::focus::FocusOutcome,
+    (focus_d, pupil_mm, pupil_source): (f64, f64, String),
+    physiology: super::correction::Physiology,
+    kernels: Option<KernelInfo>,
+) -> Result<()> {
+    let output_ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let (from_cache, psfs, missed, seconds_kernels, max_radius) = match kernels {
+        Some(k) => (k.from_cache, k.psfs, k.missed, k.seconds, k.max_radius),
+        None => (false, 0, None, 0.0, 0),
+    };
+    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
+    if output_ext.as_deref() == Some("exr") {
+        image_io::write_exr_rgba(&args.output, &image)?;
+    } else {
+        let mode = match args.tonemap {
+            TonemapArg::Clamp => TonemapMode::Clamp,
+            TonemapArg::Reinhard => TonemapMode::Reinhard,
+        };
+        // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
+        let exposure_ev = args.exposure.unwrap_or_else(|| {
+            Tonemap::auto_exposure_ev(&ImageRgba::new(
+                input.width,
+                input.height,
+                input.color.clone(),
+            ))
+        });
+        image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })?;
+    }
+    let gpu: Option<Vec<(String, f64)>> = frame
+        .timings
+        .as_ref()
+        .map(|t| t.passes.iter().map(|p| (p.name.clone(), p.ms)).collect());
+    let summary = Summary {
+        output: args.output.display().to_string(),
+        input: input.label.clone(),
+        eye: args.eye.clone(),
+        width: input.width,
+        height: input.height,
+        fov_y_deg: input.fov_y_deg,
+        depth: input.depth_source.clone(),
+        depth_report: input.depth_report.clone(),
+        focus_d,
+        focus_reached_d: focus.actual_d,
+        focus_actual_d: focus.actual_d,
+        focus_clamped: focus.clamped(),
+        focus_limit: focus.limit,
+        physiology,
+        pupil_mm,
+        pupil_source,
+        warnings: input.warnings.clone(),
+        method: args.method.name(),
+        seconds_render: frame.seconds,
+        seconds_kernels,
+        kernels_from_cache: from_cache,
+        psfs_computed: psfs,
+        psf_missed_energy: missed,
+        max_radius_px: max_radius,
+        gpu_total_ms: frame.timings.as_ref().map(|t| t.total_ms()),
+        gpu_ms: gpu,
+        device: ctx.device_info().name.clone(),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary)
+                .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?
+        );
+        return Ok(());
+    }
+    let distance = |d: f64| {
+        if d > 0.0 {
+            format!("{:.3} m", 1.0 / d)
+        } else {
+            "infinity".into()
+        }
+    };
+    let focus = match focus.limit {
+        crate::eye::FocusLimit::Reached => distance(focus_d),
+        crate::eye::FocusLimit::FarPoint => format!(
+            "{} (its far point; asked {}, beyond it)",
+            distance(focus.actual_d),
+            distance(focus_d)
+        ),
+        crate::eye::FocusLimit::NearPoint => format!(
+            "{} (its near point, clamped; asked {}, nearer)",
+            distance(focus.actual_d),
+            distance(focus_d)
+        ),
+    };
+    let through = summary
+        .physiology
+        .correction
+        .as_ref()
+        .map(|c| format!(" through {c}"))
+        .unwrap_or_default();
+    let focus = format!("{focus}{through}");
+    println!(
+        "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
+        summary.output,
+        input.width,
+        input.height,
+        input.label,
+        args.eye,
+        pupil_mm,
+        summary.pupil_source,
+        args.method.name(),
+        frame.seconds,
+        if args.method == Method::Views {
+            "none".to_string()
+        } else if from_cache {
+            "from cache".to_string()
+        } else {
+            format!("{psfs} PSFs in {seconds_kernels:.1} s")
+        }
+    );
+    if args.timings {
+        if let Some(t) = &frame.timings {
+            for p in &t.passes {
+                println!("  {:<12} {:>9.3} ms", p.name, p.ms);
+            }
+            println!(
+                "  {:<12} {:>9.3} ms  (GPU, {})",
+                "total",
+                t.total_ms(),
+                summary.device
+            );
+        } else {
+            println!("  (--timings applies to --method splat)");
+        }
+    }
+    Ok(())
+}
