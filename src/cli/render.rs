@@ -568,8 +568,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             &input,
             frame,
             focus,
-            (focus_d, pupil_mm, pupil_source),
-            physiology,
+            (focus_d, pupil_mm, pupil_source, physiology),
             None,
         );
     }
@@ -615,8 +614,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         &input,
         frame,
         focus,
-        (focus_d, pupil_mm, pupil_source),
-        physiology,
+        (focus_d, pupil_mm, pupil_source, physiology),
         Some(info),
     )
 }

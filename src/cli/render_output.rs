@@ -64,8 +64,12 @@ pub(super) fn finish(
     input: &Input,
     frame: crate::render::frame::RenderedFrame,
     focus: crate::render::focus::FocusOutcome,
-    (focus_d, pupil_mm, pupil_source): (f64, f64, String),
-    physiology: super::correction::Physiology,
+    (focus_d, pupil_mm, pupil_source, physiology): (
+        f64,
+        f64,
+        String,
+        super::correction::Physiology,
+    ),
     kernels: Option<KernelInfo>,
 ) -> Result<()> {
     let output_ext = args
