@@ -102,6 +102,14 @@ fn steady_frames_are_one_submission_without_allocations() {
             next.stats.submission_objects, 0,
             "a steady frame reuses its command buffer, fence and pools"
         );
+        // Barriers only where a command depends on an earlier one: fewer than commands (a
+        // barrier after every command, as before, would make them equal).
+        assert!(
+            next.stats.barriers > 0 && next.stats.barriers < next.stats.commands,
+            "{} barriers for {} commands",
+            next.stats.barriers,
+            next.stats.commands
+        );
         let image_bytes = u64::from(W * H) * 16;
         assert_eq!(next.stats.readback_bytes, image_bytes + 8);
         assert!(next.stats.upload_bytes <= u64::from(W * H) * 20 + 11 * 16);

@@ -131,6 +131,9 @@ struct Counters {
     allocations: u32,
     /// Vulkan objects created for the frame's submissions (0: all reused).
     submission_objects: u64,
+    /// Commands recorded, and barriers their declared accesses called for.
+    commands: u32,
+    barriers: u32,
     upload_bytes: u64,
     readback_bytes: u64,
 }
@@ -191,6 +194,8 @@ fn time_frames(
                 submissions: s.submissions,
                 allocations: s.allocations,
                 submission_objects: s.submission_objects,
+                commands: s.commands,
+                barriers: s.barriers,
                 upload_bytes: s.upload_bytes,
                 readback_bytes: s.readback_bytes,
             };
@@ -399,8 +404,8 @@ fn print_table(r: &Report) {
     );
     let c = &r.counters;
     println!(
-        "  per frame: {} submission(s), {} allocation(s), {} Vulkan object(s) created, {} B up, {} B down",
-        c.submissions, c.allocations, c.submission_objects, c.upload_bytes, c.readback_bytes
+        "  per frame: {} submission(s), {} allocation(s), {} Vulkan object(s) created, {} barrier(s) for {} command(s), {} B up, {} B down",
+        c.submissions, c.allocations, c.submission_objects, c.barriers, c.commands, c.upload_bytes, c.readback_bytes
     );
     if let Some(b) = &r.baseline {
         println!();

@@ -225,6 +225,10 @@ pub struct SplatStats {
     /// Vulkan objects (command buffers, fences, query and descriptor pools) created for this
     /// frame's submissions: 0 once the device's submission objects are warm.
     pub submission_objects: u64,
+    /// Commands recorded and barriers the declared accesses called for (a barrier after every
+    /// command would make them equal).
+    pub commands: u32,
+    pub barriers: u32,
     pub upload_bytes: u64,
     pub readback_bytes: u64,
 }
@@ -584,6 +588,7 @@ impl Splatter {
             && self.entries.is_some()
             && self.last_lists.is_some_and(|(_, bands)| bands == 1);
         let mut submissions = 0u32;
+        let mut sync = (0u32, 0u32);
         if one_submission {
             let entries = self.entries.as_ref().expect("checked above");
             let mut p = params;
@@ -607,6 +612,7 @@ impl Splatter {
                 self.record_band(rec, frame, &p, entries, tiles)?;
                 rec.end_pass();
                 rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
+                sync = rec.barrier_counts();
                 Ok(())
             })?;
             submissions += 1;
@@ -624,6 +630,8 @@ impl Splatter {
                     submissions,
                     allocations: self.allocations - allocations_before,
                     submission_objects: ctx.submission_objects_created() - objects_before,
+                    barriers: sync.0,
+                    commands: sync.1,
                     upload_bytes,
                     readback_bytes: output_bytes + 8,
                 };
@@ -654,6 +662,8 @@ impl Splatter {
                 u64::from(tiles + 1) * 4,
                 u64::from(tiles + 1) * 4,
             );
+            let (b, c) = rec.barrier_counts();
+            sync = (sync.0 + b, sync.1 + c);
             Ok(())
         })?;
         submissions += 1;
@@ -688,6 +698,8 @@ impl Splatter {
             }
             rec.end_pass();
             rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
+            let (b, c) = rec.barrier_counts();
+            sync = (sync.0 + b, sync.1 + c);
             Ok(())
         })?;
         submissions += 1;
@@ -704,6 +716,8 @@ impl Splatter {
             submissions,
             allocations: self.allocations - allocations_before,
             submission_objects: ctx.submission_objects_created() - objects_before,
+            barriers: sync.0,
+            commands: sync.1,
             upload_bytes,
             readback_bytes: output_bytes + u64::from(2 * (tiles + 1)) * 4,
         };
