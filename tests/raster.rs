@@ -496,3 +496,68 @@ color = [0.5, 1.0, 2.0]
     drop(raster);
     common::finish(ctx);
 }
+
+/// A spectacle lens moves every direction it is looked through: a −6.84 D sphere with a
+/// −2.00 D cylinder at axis 180, 12 mm in front of the cornea, seen from the entrance pupil
+/// 3.05 mm behind it, minifies by the power factor 1/(1 − h·F) of each principal meridian
+/// (textbook spectacle magnification, computed here per meridian): horizontally by the
+/// sphere's, vertically by sphere + cylinder's. The rasterised square's width and height
+/// follow; its depth (the object's distance) does not change.
+#[test]
+fn spectacle_magnification_scales_the_view_per_meridian() {
+    use ocular::eye::correction::Spectacle;
+    let ctx = common::gpu();
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    let (w, h) = (160u32, 90u32);
+    let fov = 30.0f64;
+    let (half, distance) = (0.2, 2.0);
+    let s = square_scene(half, distance, fov);
+    let spectacle = Spectacle {
+        sphere_d: -6.84,
+        cylinder_d: -2.0,
+        axis_deg: 180.0,
+        vertex_mm: 12.0,
+    };
+    let h_m = (12.0 + 3.05) * 1e-3;
+    let expected = [1.0 / (1.0 + h_m * 6.84), 1.0 / (1.0 + h_m * 8.84)];
+    let side = 0.5 * f64::from(h) / (fov.to_radians() / 2.0).tan() * 2.0 * half / distance;
+    // Width along the central rows and height along the central columns, from coverage.
+    let extent = |frame: &ocular::render::Frame| {
+        let cov = |x: u32, y: u32| {
+            let c = frame.color[(y * w + x) as usize];
+            f64::from(luminance([c[0], c[1], c[2]])) / 100.0
+        };
+        let width: f64 = (43..47)
+            .map(|y| (0..w).map(|x| cov(x, y)).sum::<f64>())
+            .sum::<f64>()
+            / 4.0;
+        let height: f64 = (78..82)
+            .map(|x| (0..h).map(|y| cov(x, y)).sum::<f64>())
+            .sum::<f64>()
+            / 4.0;
+        [width, height]
+    };
+    let plain = extent(&raster.render(&ctx, &s.at_time(0.0), w, h).unwrap());
+    raster.set_view_magnification(spectacle.angular_magnification(3.05));
+    let frame = raster.render(&ctx, &s.at_time(0.0), w, h).unwrap();
+    let seen = extent(&frame);
+    eprintln!(
+        "square {side:.2} px: plain {plain:?}, through the spectacle {seen:?}, expected {:?}",
+        [side * expected[0], side * expected[1]]
+    );
+    for axis in 0..2 {
+        assert!((plain[axis] - side).abs() < 0.6, "{plain:?} vs {side}");
+        assert!(
+            (seen[axis] - side * expected[axis]).abs() < 0.6,
+            "axis {axis}: {} px, expected {}",
+            seen[axis],
+            side * expected[axis]
+        );
+    }
+    assert!(frame
+        .depth_m
+        .iter()
+        .all(|&d| d == 100.0 || ((f64::from(d) - distance) / distance).abs() < 1e-4));
+    drop(raster);
+    common::finish(ctx);
+}

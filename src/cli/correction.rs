@@ -92,6 +92,24 @@ pub struct Physiology {
     /// The correction in `--correct` form, with its vertex distance.
     pub correction: Option<String>,
     pub iol_d: Option<f64>,
+    /// How the spectacle maps directions (2×2 on tangents, x right, y up; see
+    /// `Spectacle::angular_magnification`): what the renderer warps scenes by.
+    pub spectacle_magnification: Option<[[f64; 2]; 2]>,
+}
+
+/// The angular magnification of `eye`'s spectacle, seen from the bare eye's entrance pupil
+/// (paraxial, at the renderer's green wavelength).
+pub(crate) fn spectacle_magnification(eye: &Eye) -> Result<Option<[[f64; 2]; 2]>> {
+    let Some(spectacle) = eye.correction else {
+        return Ok(None);
+    };
+    let mut bare = eye.clone();
+    bare.correction = None;
+    let sys = bare
+        .system()
+        .map_err(|err| Error::input(format!("--correct: {err}")))?;
+    let pupil_mm = crate::eye::paraxial::paraxial(&sys, 549.0, 0.0).entrance_pupil_z_mm;
+    Ok(Some(spectacle.angular_magnification(pupil_mm)))
 }
 
 impl CorrectionArgs {
@@ -155,6 +173,7 @@ impl CorrectionArgs {
             },
             correction: e.correction.map(|s| describe(&s)),
             iol_d: e.iol.map(|i| i.power_d),
+            spectacle_magnification: spectacle_magnification(&e)?,
         };
         Ok((e, physiology))
     }

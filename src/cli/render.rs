@@ -237,7 +237,12 @@ pub(super) struct Input {
     pub(super) warnings: Vec<String>,
 }
 
-fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
+fn load_input(
+    cli: &Cli,
+    args: &RenderArgs,
+    ctx: &Context,
+    magnification: Option<[[f64; 2]; 2]>,
+) -> Result<Input> {
     if let Some(color_path) = &args.color {
         let fov_y_deg = args.fov_y.ok_or_else(|| {
             Error::input(
@@ -255,6 +260,14 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
             white_cdm2: args.white_cdm2,
             repair_nonfinite: args.repair_nonfinite,
         })?;
+        let mut warnings = file.warnings;
+        if magnification.is_some() {
+            warnings.push(
+                "--correct: the spectacle's magnification is applied to scenes; colour/depth files \
+                 are shown at their own scale (its blur and aberrations are applied)"
+                    .into(),
+            );
+        }
         return Ok(Input {
             width: file.color.width,
             height: file.color.height,
@@ -272,7 +285,7 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
                 .into_iter()
                 .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
                 .collect(),
-            warnings: file.warnings,
+            warnings,
         });
     }
     let _ = cli;
@@ -293,6 +306,10 @@ fn load_input(cli: &Cli, args: &RenderArgs, ctx: &Context) -> Result<Input> {
         .unwrap_or((scene.resolution[0], scene.resolution[1]));
     let mut rasterizer = Rasterizer::new(ctx)?;
     let mut warnings = Vec::new();
+    // The world seen through the spectacle: its angular magnification moves every direction.
+    if let Some(m) = magnification {
+        rasterizer.set_view_magnification(m);
+    }
     let k = if args.method == Method::Splat {
         super::occlusion::scene_layers(ctx, args.layers, (width, height), &mut warnings)
     } else {
@@ -514,7 +531,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         Some((args.age, args.accommodation_line)),
     )?;
     let ctx = Context::new(&cli.context_options())?;
-    let input = load_input(cli, args, &ctx)?;
+    let input = load_input(cli, args, &ctx, physiology.spectacle_magnification)?;
     for w in &input.warnings {
         eprintln!("warning: {w}");
     }

@@ -508,25 +508,41 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         }
     }
 
+    // Each panel sees the scene through its own spectacle (if any): its magnification moves
+    // every direction, so such a panel gets its own raster.
+    let magnifications = eyes
+        .iter()
+        .map(|(_, e)| super::correction::spectacle_magnification(e))
+        .collect::<Result<Vec<_>>>()?;
+    const IDENTITY: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
     let bar = progress_bar(todo.len() as u64);
     let started = Instant::now();
     for &i in &todo {
         let state = timeline.state(i);
+        rasterizer.set_view_magnification(IDENTITY);
         let frame = rasterizer.render(&ctx, &state, width, height)?;
         let eye_state = EyeState {
             focus_d: timeline.focus_d(i, &state),
             pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
         };
-        let input = FrameInput {
-            width,
-            height,
-            color: &frame.color,
-            depth_m: &frame.depth_m,
-            fov_y_deg: state.camera.fov_y_deg,
-            hidden_layers: &[],
-        };
         let mut panels = Vec::new();
-        for renderer in renderers.iter_mut() {
+        for (renderer, magnification) in renderers.iter_mut().zip(&magnifications) {
+            let through = match magnification {
+                Some(m) => {
+                    rasterizer.set_view_magnification(*m);
+                    Some(rasterizer.render(&ctx, &state, width, height)?)
+                }
+                None => None,
+            };
+            let seen = through.as_ref().unwrap_or(&frame);
+            let input = FrameInput {
+                width,
+                height,
+                color: &seen.color,
+                depth_m: &seen.depth_m,
+                fov_y_deg: state.camera.fov_y_deg,
+                hidden_layers: &[],
+            };
             panels.push(renderer.render(&input, eye_state, Method::Splat)?.color);
         }
         let labels: Vec<&str> = eyes.iter().map(|(name, _)| name.as_str()).collect();

@@ -45,6 +45,41 @@ pub struct Spectacle {
     pub vertex_mm: f64,
 }
 
+impl Spectacle {
+    /// Power matrix (D) in the lens plane, x right and y up as the wearer sees: the sphere
+    /// along the axis, sphere + cylinder across it (minus-cylinder form, axis counter-clockwise
+    /// from +x).
+    pub fn power_matrix_d(&self) -> [[f64; 2]; 2] {
+        let a = self.axis_deg.to_radians();
+        // The cylinder's power acts across its axis.
+        let (nx, ny) = (-a.sin(), a.cos());
+        let (s, c) = (self.sphere_d, self.cylinder_d);
+        [
+            [s + c * nx * nx, c * nx * ny],
+            [c * nx * ny, s + c * ny * ny],
+        ]
+    }
+
+    /// Angular magnification for distant objects of this lens `vertex_mm` in front of the
+    /// cornea, seen from an entrance pupil `pupil_behind_cornea_mm` behind it: a chief ray
+    /// that leaves the lens at tangent t crossed it at height −h·t (h = vertex + pupil depth)
+    /// and was bent by −P·(−h·t), so t = t₀ + h·P·t and t = (I − h·P)⁻¹·t₀ (the spectacle
+    /// magnification's power factor; a thin lens has no shape factor).
+    pub fn angular_magnification(&self, pupil_behind_cornea_mm: f64) -> [[f64; 2]; 2] {
+        let h_m = 1e-3 * (self.vertex_mm + pupil_behind_cornea_mm);
+        let p = self.power_matrix_d();
+        let a = [
+            [1.0 - h_m * p[0][0], -h_m * p[0][1]],
+            [-h_m * p[1][0], 1.0 - h_m * p[1][1]],
+        ];
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ]
+    }
+}
+
 fn default_axis() -> f64 {
     180.0
 }

@@ -111,6 +111,9 @@ pub struct Rasterizer {
     white: Image,
     scene: Option<GpuScene>,
     targets: Option<Targets>,
+    /// How directions in front of the eye appear (view-space x, y: +x right, +y up): the
+    /// angular magnification of a spectacle lens, identity without one.
+    view_magnification: [[f64; 2]; 2],
 }
 
 impl Rasterizer {
@@ -139,6 +142,7 @@ impl Rasterizer {
             white,
             scene: None,
             targets: None,
+            view_magnification: [[1.0, 0.0], [0.0, 1.0]],
         })
     }
 
@@ -313,6 +317,26 @@ impl Rasterizer {
         Ok(())
     }
 
+    /// Draws every later frame as seen through an optical element that maps a direction's
+    /// tangents t to `m`·t (view space, +x right, +y up), such as a spectacle lens's angular
+    /// magnification ([`crate::eye::correction::Spectacle::angular_magnification`]). Depth
+    /// stays the distance along the camera's view axis: the element moves images, not objects.
+    pub fn set_view_magnification(&mut self, m: [[f64; 2]; 2]) {
+        self.view_magnification = m;
+    }
+
+    /// World → clip of `camera` for this frame, with the view magnification.
+    fn view_projection(&self, camera: &crate::scene::Camera, aspect: f64) -> glam::DMat4 {
+        let m = self.view_magnification;
+        let magnify = glam::DMat4::from_cols(
+            glam::DVec4::new(m[0][0], m[1][0], 0.0, 0.0),
+            glam::DVec4::new(m[0][1], m[1][1], 0.0, 0.0),
+            glam::DVec4::Z,
+            glam::DVec4::W,
+        );
+        camera.projection_matrix(aspect) * magnify * camera.view_matrix()
+    }
+
     /// Renders `state` at `width × height` and reads colour and depth back.
     pub fn render(
         &mut self,
@@ -322,8 +346,7 @@ impl Rasterizer {
         height: u32,
     ) -> Result<Frame> {
         let camera = &state.camera;
-        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
-        let view_proj = projection * camera.view_matrix();
+        let view_proj = self.view_projection(camera, f64::from(width) / f64::from(height));
         self.render_from(ctx, state, width, height, view_proj, camera.position_m)
     }
 
@@ -356,8 +379,7 @@ impl Rasterizer {
         gap_d: f32,
     ) -> Result<Vec<Frame>> {
         let camera = &state.camera;
-        let projection = camera.projection_matrix(f64::from(width) / f64::from(height));
-        let view_proj = projection * camera.view_matrix();
+        let view_proj = self.view_projection(camera, f64::from(width) / f64::from(height));
         let mut frames = vec![self.render(ctx, state, width, height)?];
         for _ in 1..layers {
             let previous = &frames.last().expect("layer 0 is there").depth_m;
