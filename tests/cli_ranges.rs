@@ -21,6 +21,18 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// The primitives scene with one line replaced, written into `dir`.
+fn primitives_with(dir: &std::path::Path, line: &str, by: &str) -> PathBuf {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/primitives.toml"),
+    )
+    .unwrap();
+    assert!(text.contains(line), "{line}");
+    let path = dir.join("s.toml");
+    std::fs::write(&path, text.replace(line, by)).unwrap();
+    path
+}
+
 fn refused(args: &[&str], names: &str, allowed: &str) {
     let out = ocular(args);
     let err = String::from_utf8_lossy(&out.stderr);
@@ -83,13 +95,11 @@ fn pupil_range_is_the_same_everywhere() {
             "pupil diameter",
             PUPIL,
         );
-        let scene = dir.join("s.toml");
-        let text = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/primitives.toml"),
-        )
-        .unwrap()
-        .replace("focus_m = 7.5", &format!("focus_m = 7.5\npupil_mm = {p}"));
-        std::fs::write(&scene, text).unwrap();
+        let scene = primitives_with(
+            &dir,
+            "focus_m = 7.5",
+            &format!("focus_m = 7.5\npupil_mm = {p}"),
+        );
         refused(
             &["raster", "--scene", scene.to_str().unwrap(), "-o", out],
             "pupil_mm",
@@ -207,13 +217,7 @@ fn field_of_view_range_is_the_same_everywhere() {
             "fov-y",
             FOV,
         );
-        let scene = dir.join("s.toml");
-        let text = std::fs::read_to_string(
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/primitives.toml"),
-        )
-        .unwrap()
-        .replace("fov_y_deg = 60.0", &format!("fov_y_deg = {f}"));
-        std::fs::write(&scene, text).unwrap();
+        let scene = primitives_with(&dir, "fov_y_deg = 60.0", &format!("fov_y_deg = {f}"));
         refused(
             &["raster", "--scene", scene.to_str().unwrap(), "-o", out],
             "fov_y_deg",

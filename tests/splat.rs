@@ -463,14 +463,9 @@ fn occlusion_is_ordered_like_the_ground_truth() {
     common::finish(ctx);
 }
 
-#[test]
-fn every_pass_matches_its_cpu_step() {
-    let ctx = common::gpu();
-    let eye = SyntheticEye::new(0.2, 5.0);
-    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
-    let grid = eye.grid(objects, max_radius, &[4.0], 90);
-    // Large smooth regions merge; the textured square and the edges do not.
-    let scene = Scene::new(96, 64, |x, y| {
+/// 96×64: large smooth regions that merge, a textured square and edges that do not.
+fn merging_scene() -> Scene {
+    Scene::new(96, 64, |x, y| {
         if (40..70).contains(&x) && (10..40).contains(&y) {
             (texture(x, y, 3.0), 0.4)
         } else if x < 30 {
@@ -478,7 +473,16 @@ fn every_pass_matches_its_cpu_step() {
         } else {
             ([0.7, 0.7, 0.7], 2.0)
         }
-    });
+    })
+}
+
+#[test]
+fn every_pass_matches_its_cpu_step() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.2, 5.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let scene = merging_scene();
     let merge = MergeSettings {
         levels: 2,
         ..MergeSettings::default()
@@ -665,15 +669,7 @@ fn fragments_split_over_four_bindings_render_the_same() {
     let eye = SyntheticEye::new(0.2, 5.0);
     let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
     let grid = eye.grid(objects, max_radius, &[4.0], 90);
-    let scene = Scene::new(96, 64, |x, y| {
-        if (40..70).contains(&x) && (10..40).contains(&y) {
-            (texture(x, y, 3.0), 0.4)
-        } else if x < 30 {
-            ([0.2, 0.4, 0.6], 0.5)
-        } else {
-            ([0.7, 0.7, 0.7], 2.0)
-        }
-    });
+    let scene = merging_scene();
     let merge = MergeSettings {
         levels: 2,
         ..MergeSettings::default()

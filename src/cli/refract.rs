@@ -37,18 +37,20 @@ fn number(text: &str) -> std::result::Result<f64, String> {
 
 fn parse_pupil_mm(text: &str) -> std::result::Result<f64, String> {
     let v = number(text)?;
-    crate::limits::PUPIL_MM
-        .check("", v)
-        .map(|_| v)
-        .map_err(|e| e.trim().to_string())
+    within(crate::limits::PUPIL_MM, v)
 }
 
 fn parse_wavelength_nm(text: &str) -> std::result::Result<f64, String> {
     let v = number(text)?;
-    crate::limits::WAVELENGTH_NM
-        .check("", v)
-        .map(|_| v)
-        .map_err(|e| e.trim().to_string())
+    within(crate::limits::WAVELENGTH_NM, v)
+}
+
+fn within(limit: crate::limits::Limit, v: f64) -> std::result::Result<f64, String> {
+    if limit.contains(v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is outside {}", limit.allowed()))
+    }
 }
 
 pub fn run(a: &RefractArgs) -> Result<()> {

@@ -60,7 +60,6 @@ mod op {
 mod deco {
     pub const BUFFER_BLOCK: u32 = 3;
     pub const ARRAY_STRIDE: u32 = 6;
-    pub const MATRIX_STRIDE: u32 = 7;
     pub const NON_WRITABLE: u32 = 24;
     pub const NON_READABLE: u32 = 25;
     pub const BINDING: u32 = 33;
@@ -103,14 +102,9 @@ struct Module {
 
 /// Reads `spirv` (bytes of a SPIR-V module). Errors name what is malformed.
 pub fn reflect(spirv: &[u8]) -> Result<Reflection, String> {
-    if !spirv.len().is_multiple_of(4) || spirv.len() < 20 {
-        return Err("not a SPIR-V module (length)".into());
-    }
-    let words: Vec<u32> = spirv
-        .chunks_exact(4)
-        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    if words[0] != 0x0723_0203 {
+    let words = ash::util::read_spv(&mut std::io::Cursor::new(spirv))
+        .map_err(|e| format!("not a SPIR-V module ({e})"))?;
+    if words.len() < 5 || words[0] != 0x0723_0203 {
         return Err("not a SPIR-V module (magic number)".into());
     }
     let module = parse(&words[5..])?;
@@ -216,9 +210,6 @@ impl Module {
                         .get(&(id, i as u32, deco::OFFSET))
                         .copied()
                         .ok_or("struct member without an offset")?;
-                    let _ = self
-                        .member_decorations
-                        .get(&(id, i as u32, deco::MATRIX_STRIDE));
                     end = end.max(offset + self.size_of(member)?);
                 }
                 end
