@@ -232,7 +232,8 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
     let (focus_d, pupil_mm) = (eye_state.focus_d, eye_state.pupil_mm);
-    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let precompute = Precompute {
         from_cache: kernels.report.is_none(),

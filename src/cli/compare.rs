@@ -229,6 +229,13 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 .replace("sample_um", "--sample-um"),
         )
     })?;
+    if args.splat.off_axis && matches!(args.truth, TruthArg::Views) {
+        return Err(Error::input(
+            "--off-axis is judged against --truth reference (the views truth traces the eye on \
+             axis only)",
+        ));
+    }
+    options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let mut notes = Vec::new();
     let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
@@ -337,7 +344,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     } else {
         None
     };
-    let slices_frame = if args.no_slices {
+    // slices have no off-axis variant: leave them out rather than compare the on-axis PSF
+    let slices_frame = if args.no_slices || args.splat.off_axis {
         None
     } else {
         Some(renderer.render(&input, eye_state, Method::Slices)?)

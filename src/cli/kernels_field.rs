@@ -4,13 +4,11 @@
 //! (I, J the indices of its angles on the two axes).
 
 use super::outputs::Outputs;
-use crate::eye::accommodate;
 use crate::eye::Eye;
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
 use crate::psf::cache::{cached, write_grid, CacheOutcome};
-use crate::psf::defocus::distance_of;
 use crate::psf::field::{compute_field_grid, field_grid_key, FieldAxes};
-use crate::psf::field_plan::{plan_field_axes, FieldPlan, Probe, FIELD_TOLERANCE_UM};
+use crate::psf::field_plan::FieldPlan;
 use crate::psf::grid::no_progress;
 use crate::{Error, Result};
 use std::path::{Path, PathBuf};
@@ -54,30 +52,9 @@ struct Index {
     node: Vec<Node>,
 }
 
-/// The directions a frame needs ([`crate::psf::field_plan`]), measured with the grid's
-/// largest pupil at its green wavelength, the eye focused at its first focus state.
+/// The directions a frame needs ([`crate::psf::field_plan::plan_for_frame`]).
 pub fn plan(eye: &Eye, axes: &GridAxes, screen: &Screen, width_px: u32) -> Result<FieldPlan> {
-    let pupil_mm = axes.pupils_mm.last().copied().unwrap_or(4.0);
-    let focus = distance_of(axes.focus_d.first().copied().unwrap_or(0.0));
-    let wavelength_nm = axes.wavelengths_nm[1];
-    let focused = match focus {
-        None => eye.clone(),
-        Some(_) => accommodate(eye, focus, pupil_mm, wavelength_nm)?.eye,
-    };
-    let sys = focused.system()?;
-    let probe = Probe {
-        sys: &sys,
-        wavelength_nm,
-        pupil_mm,
-        object_distance_m: focus,
-    };
-    plan_field_axes(
-        &probe,
-        screen.fov_y_deg,
-        width_px,
-        screen.height_px,
-        FIELD_TOLERANCE_UM,
-    )
+    crate::psf::field_plan::plan_for_frame(eye, axes, screen, width_px)
 }
 
 /// Registers the index and every node's file (so that a bad name fails before any work).

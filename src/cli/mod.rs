@@ -171,6 +171,11 @@ pub struct SplatArgs {
     pub merge_color_tolerance: f32,
     #[command(flatten)]
     pub blend: BlendArgs,
+    /// Aberrations across the visual field: each pixel gets the PSF of the eye traced for its
+    /// own direction, mixed from a lattice of directions planned from the frame (splat and
+    /// reference). Off: the on-axis PSF everywhere.
+    #[arg(long)]
+    pub off_axis: bool,
 }
 
 impl SplatArgs {

@@ -545,7 +545,16 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         )));
     }
     let (pupil_mm, pupil_source) = pupil_diameter(args, &input)?;
-    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    if args.splat.off_axis {
+        if matches!(args.method, Method::Slices | Method::Views) {
+            return Err(Error::input(
+                "--off-axis applies to --method splat and reference (slices and views use the \
+                 on-axis PSF)",
+            ));
+        }
+        options.field_width_px = Some(input.width);
+    }
     let focus = crate::render::focus::effective_focus(
         &eye,
         focus_d,
@@ -598,6 +607,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         .map(|r| r.columns.iter().map(|c| c.missed_energy).collect());
     let seconds_kernels = kernels.seconds;
     let max_radius = kernels.grid.max_radius_px;
+    let field = kernels.field.as_ref().map(|f| f.plan.clone());
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
         .hidden
@@ -624,6 +634,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         missed,
         seconds: seconds_kernels,
         max_radius,
+        field,
     };
     super::render_output::finish(
         args,

@@ -43,6 +43,10 @@ pub(super) struct Summary {
     /// (null when the kernels came from the cache: they were checked when computed).
     psf_missed_energy: Option<Vec<[f64; 3]>>,
     max_radius_px: u32,
+    /// Off axis (`--off-axis`): the lattice of field directions (degrees) and the largest
+    /// interpolation error of the wavefront its planning measured (µm RMS).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    field: Option<crate::psf::field_plan::FieldPlan>,
     gpu_ms: Option<Vec<(String, f64)>>,
     gpu_total_ms: Option<f64>,
     device: String,
@@ -55,6 +59,8 @@ pub(super) struct KernelInfo {
     pub(super) missed: Option<Vec<[f64; 3]>>,
     pub(super) seconds: f64,
     pub(super) max_radius: u32,
+    /// Off axis: the field lattice the kernels were computed over.
+    pub(super) field: Option<crate::psf::field_plan::FieldPlan>,
 }
 
 /// Writes the output and prints the summary.
@@ -77,9 +83,16 @@ pub(super) fn finish(
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let (from_cache, psfs, missed, seconds_kernels, max_radius) = match kernels {
-        Some(k) => (k.from_cache, k.psfs, k.missed, k.seconds, k.max_radius),
-        None => (false, 0, None, 0.0, 0),
+    let (from_cache, psfs, missed, seconds_kernels, max_radius, field) = match kernels {
+        Some(k) => (
+            k.from_cache,
+            k.psfs,
+            k.missed,
+            k.seconds,
+            k.max_radius,
+            k.field,
+        ),
+        None => (false, 0, None, 0.0, 0, None),
     };
     let image = ImageRgba::new(input.width, input.height, frame.color.clone());
     if output_ext.as_deref() == Some("exr") {
@@ -128,6 +141,7 @@ pub(super) fn finish(
         psfs_computed: psfs,
         psf_missed_energy: missed,
         max_radius_px: max_radius,
+        field,
         gpu_total_ms: frame.timings.as_ref().map(|t| t.total_ms()),
         gpu_ms: gpu,
         device: ctx.device_info().name.clone(),
@@ -186,6 +200,18 @@ pub(super) fn finish(
             format!("{psfs} PSFs in {seconds_kernels:.1} s")
         }
     );
+    if let Some(f) = &summary.field {
+        let span = |a: &[f64]| format!("{:+.1}..{:+.1}°", a[0], a[a.len() - 1]);
+        println!(
+            "  off axis: {} × {} field directions (h {}, v {}), wavefront interpolation error \
+             ≤ {:.3} µm RMS",
+            f.axes.h_deg.len(),
+            f.axes.v_deg.len(),
+            span(&f.axes.h_deg),
+            span(&f.axes.v_deg),
+            f.worst_error_um
+        );
+    }
     if args.timings {
         if let Some(t) = &frame.timings {
             for p in &t.passes {

@@ -93,6 +93,10 @@ pub struct VideoArgs {
     /// fixed, so frames do not flicker and splits agree).
     #[arg(long, allow_negative_numbers = true)]
     pub exposure: Option<f32>,
+    /// Aberrations across the visual field (as `render --off-axis`): each pixel gets the PSF of
+    /// the eye traced for its own direction, mixed from a lattice planned from the frame.
+    #[arg(long)]
+    pub off_axis: bool,
     /// Kernel cache folder; --no-cache disables it.
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
@@ -398,7 +402,8 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     let (width, height) = args
         .size
         .unwrap_or((timeline.scene.resolution[0], timeline.scene.resolution[1]));
-    let options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    options.field_width_px = args.off_axis.then_some(width);
     let splat = SplatSettings::default();
     let config = ExportConfig {
         ocular_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -418,13 +423,21 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         focus_sweep_m: sweep.map(|(a, b)| [a, b]),
         pupil_mm: args.pupil_mm,
         exposure_ev: args.exposure,
-        settings_sha256: sha256_of_debug(&[
-            &options.settings,
-            &options.reference_axes,
-            &splat,
-            &planning_frames(count),
-            &args.age,
-        ]),
+        settings_sha256: {
+            let planned = planning_frames(count);
+            let mut parts: Vec<&dyn std::fmt::Debug> = vec![
+                &options.settings,
+                &options.reference_axes,
+                &splat,
+                &planned,
+                &args.age,
+            ];
+            // on-axis exports keep the hash they always had
+            if args.off_axis {
+                parts.push(&"off-axis");
+            }
+            sha256_of_debug(&parts)
+        },
     };
     let removed = manifest::open(&args.output, &config, args.overwrite)?;
     if removed > 0 {

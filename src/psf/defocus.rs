@@ -219,48 +219,89 @@ impl ColumnOptics {
             ))
         })?;
         let (focused, focus_limit) = (f.eye, f.limit);
-        let beyond = focus_limit == FocusLimit::FarPoint;
-        let sys = focused.system()?;
-        let mut channels = Vec::with_capacity(3);
-        for wavelength_nm in wavelengths_nm {
-            let fm = measure_field(
-                &sys,
-                wavelength_nm,
-                pupil_mm,
-                distance,
-                field_deg,
-                settings.zernike_order,
-            )
-            .map_err(|e| {
-                Error::input(format!(
-                    "cannot measure the eye at pupils-mm {pupil_mm}, {wavelength_nm} nm, \
-                     focus-d {focus_d} D, field {field_deg:?}°: {e}"
-                ))
-            })?;
-            let m = &fm.measurement;
-            let e = m.entrance_pupil_z_mm * 1e-3;
-            let mut ch = ChannelOptics::from_wavefront(
-                &m.coefficients_um,
-                wavelength_nm,
-                pupil_mm,
-                vergence_at_pupil(focus_d, e),
-                e,
-                settings,
-            );
-            if field_deg != [0.0, 0.0] {
-                ch.field = Some(super::field::FieldShape::from_pupil(&fm.field, pupil_mm));
-            }
-            channels.push(ch);
-        }
-        let channels: [ChannelOptics; 3] = channels.try_into().expect("three channels");
+        let channels = measure_channels(
+            &focused,
+            pupil_mm,
+            focus_d,
+            wavelengths_nm,
+            settings,
+            field_deg,
+        )?;
         Ok(ColumnOptics {
             eye: focused.clone(),
             pupil_mm,
             focus_d,
             lens_diameter_mm: focused.lens.diameter_mm,
-            beyond_far_point: beyond,
+            beyond_far_point: focus_limit == FocusLimit::FarPoint,
             focus_limit,
             channels,
         })
     }
+
+    /// This column's focused eye measured for another field direction (no new accommodation:
+    /// the eye focuses on axis whatever direction is measured).
+    pub fn at_field(
+        &self,
+        wavelengths_nm: [f64; 3],
+        settings: &KernelSettings,
+        field_deg: [f64; 2],
+    ) -> Result<ColumnOptics> {
+        let channels = measure_channels(
+            &self.eye,
+            self.pupil_mm,
+            self.focus_d,
+            wavelengths_nm,
+            settings,
+            field_deg,
+        )?;
+        Ok(ColumnOptics {
+            channels,
+            ..self.clone()
+        })
+    }
+}
+
+/// The focused eye measured at each wavelength for `field_deg`, the object at the focus.
+fn measure_channels(
+    focused: &Eye,
+    pupil_mm: f64,
+    focus_d: f64,
+    wavelengths_nm: [f64; 3],
+    settings: &KernelSettings,
+    field_deg: [f64; 2],
+) -> Result<[ChannelOptics; 3]> {
+    let distance = distance_of(focus_d);
+    let sys = focused.system()?;
+    let mut channels = Vec::with_capacity(3);
+    for wavelength_nm in wavelengths_nm {
+        let fm = measure_field(
+            &sys,
+            wavelength_nm,
+            pupil_mm,
+            distance,
+            field_deg,
+            settings.zernike_order,
+        )
+        .map_err(|e| {
+            Error::input(format!(
+                "cannot measure the eye at pupils-mm {pupil_mm}, {wavelength_nm} nm, \
+                 focus-d {focus_d} D, field {field_deg:?}°: {e}"
+            ))
+        })?;
+        let m = &fm.measurement;
+        let e = m.entrance_pupil_z_mm * 1e-3;
+        let mut ch = ChannelOptics::from_wavefront(
+            &m.coefficients_um,
+            wavelength_nm,
+            pupil_mm,
+            vergence_at_pupil(focus_d, e),
+            e,
+            settings,
+        );
+        if field_deg != [0.0, 0.0] {
+            ch.field = Some(super::field::FieldShape::from_pupil(&fm.field, pupil_mm));
+        }
+        channels.push(ch);
+    }
+    Ok(channels.try_into().expect("three channels"))
 }

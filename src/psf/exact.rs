@@ -7,6 +7,8 @@ use super::defocus::ColumnOptics;
 use super::project::cropped_psf;
 use crate::eye::Eye;
 use crate::Result;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 
 /// A square kernel of side 2·radius + 1, row-major, row j ↔ screen offset dy = j − radius
 /// (downwards), column i ↔ dx = i − radius; normalised to sum 1.
@@ -45,6 +47,20 @@ impl Kernel {
 /// the frame's pupil, focus, resolution and field of view.
 pub trait ExactKernels: Sync {
     fn kernel(&self, channel: usize, dioptre: f64) -> Kernel;
+
+    /// The kernel for the field direction `field_deg` (degrees); on-axis sources ignore it.
+    fn kernel_in_field(&self, channel: usize, dioptre: f64, _field_deg: [f64; 2]) -> Kernel {
+        self.kernel(channel, dioptre)
+    }
+
+    /// The field step (degrees) of this source's directions; None: one PSF for every direction.
+    fn field_step_deg(&self) -> Option<f64> {
+        None
+    }
+
+    /// Readies the directions of these field bins (multiples of the field step) before their
+    /// kernels are asked for, in parallel, each once.
+    fn prepare_field_bins(&self, _bins: &[(i64, i64)]) {}
 }
 
 /// One (pupil, focus) state of an eye, projected for one screen.
@@ -81,7 +97,16 @@ impl ExactEye {
 
     /// Natural radius (px, unclamped) and kernel for a channel at an object vergence.
     pub fn kernel_checked(&self, channel: usize, dioptre: f64) -> Result<(f64, Kernel)> {
-        let ch = &self.column.channels[channel.min(2)];
+        self.kernel_of(&self.column, channel, dioptre)
+    }
+
+    fn kernel_of(
+        &self,
+        column: &ColumnOptics,
+        channel: usize,
+        dioptre: f64,
+    ) -> Result<(f64, Kernel)> {
+        let ch = &column.channels[channel.min(2)];
         let psf = cropped_psf(ch, dioptre.max(0.0), &self.screen, &self.settings)?;
         let natural = psf.natural_radius_px();
         let r = natural.min(self.max_radius_px as f64);
@@ -92,6 +117,111 @@ impl ExactEye {
             .map(|v| v as f32)
             .collect();
         Ok((natural, Kernel { radius, values }))
+    }
+}
+
+/// Off axis: the exact kernel of the eye traced for the direction of each field bin of
+/// `step_deg` (no interpolation over the field, no lattice): the ground truth of the
+/// off-axis runtime. Directions beyond the traced field take its edge along the same ray
+/// from the centre, as the runtime's lattice does.
+pub struct ExactFieldEye {
+    pub on_axis: ExactEye,
+    pub step_deg: f64,
+    wavelengths_nm: [f64; 3],
+    columns: Mutex<HashMap<(i64, i64), Arc<ColumnOptics>>>,
+}
+
+impl ExactFieldEye {
+    pub fn new(on_axis: ExactEye, wavelengths_nm: [f64; 3], step_deg: f64) -> Result<Self> {
+        if !(step_deg.is_finite() && step_deg > 0.0) {
+            return Err(crate::Error::input(format!(
+                "field step {step_deg}° must be positive"
+            )));
+        }
+        Ok(ExactFieldEye {
+            on_axis,
+            step_deg,
+            wavelengths_nm,
+            columns: Mutex::new(HashMap::new()),
+        })
+    }
+
+    fn column(&self, bin: (i64, i64)) -> Result<Arc<ColumnOptics>> {
+        if let Some(c) = self.columns.lock().expect("not poisoned").get(&bin) {
+            return Ok(c.clone());
+        }
+        let field =
+            within_traced_field([bin.0 as f64 * self.step_deg, bin.1 as f64 * self.step_deg]);
+        let c = Arc::new(self.on_axis.column.at_field(
+            self.wavelengths_nm,
+            &self.on_axis.settings,
+            field,
+        )?);
+        self.columns
+            .lock()
+            .expect("not poisoned")
+            .insert(bin, c.clone());
+        Ok(c)
+    }
+
+    fn bin(&self, field_deg: [f64; 2]) -> (i64, i64) {
+        (
+            (field_deg[0] / self.step_deg).round() as i64,
+            (field_deg[1] / self.step_deg).round() as i64,
+        )
+    }
+}
+
+/// `field_deg`, or where the ray from the axis through it leaves the traced field.
+pub fn within_traced_field(field_deg: [f64; 2]) -> [f64; 2] {
+    use crate::eye::field::{check_field_deg, MAX_FIELD_DEG};
+    if check_field_deg(field_deg).is_ok() {
+        return field_deg;
+    }
+    let limit = MAX_FIELD_DEG - 1e-6;
+    let inside = |m: f64| {
+        let f = [field_deg[0] * m, field_deg[1] * m];
+        crate::eye::field::eccentricity_deg(f) <= limit
+            && f[0].abs() <= limit
+            && f[1].abs() <= limit
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if inside(m) {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    [field_deg[0] * lo, field_deg[1] * lo]
+}
+
+impl ExactKernels for ExactFieldEye {
+    fn kernel(&self, channel: usize, dioptre: f64) -> Kernel {
+        self.kernel_in_field(channel, dioptre, [0.0, 0.0])
+    }
+
+    fn kernel_in_field(&self, channel: usize, dioptre: f64, field_deg: [f64; 2]) -> Kernel {
+        self.column(self.bin(field_deg))
+            .and_then(|c| self.on_axis.kernel_of(&c, channel, dioptre))
+            .map(|(_, k)| k)
+            .unwrap_or_else(|_| Kernel {
+                radius: 0,
+                values: vec![1.0],
+            })
+    }
+
+    fn field_step_deg(&self) -> Option<f64> {
+        Some(self.step_deg)
+    }
+
+    fn prepare_field_bins(&self, bins: &[(i64, i64)]) {
+        use rayon::prelude::*;
+        // a failure shows up again, and is handled, when the bin's kernel is asked for
+        bins.par_iter().for_each(|&b| {
+            let _ = self.column(b);
+        });
     }
 }
 

@@ -8,9 +8,11 @@
 //! move the image) must stay within the tolerance. The default, 0.04 µm, is λ/14 at 555 nm
 //! (Maréchal's criterion for a wavefront that leaves the PSF essentially unchanged).
 
+use super::axes::{GridAxes, Screen};
+use super::defocus::distance_of;
 use super::field::{frame_half_field_deg, FieldAxes};
 use crate::eye::field::{eccentricity_deg, measure_field, MAX_FIELD_DEG};
-use crate::eye::OpticalSystem;
+use crate::eye::{accommodate, Eye, OpticalSystem};
 use crate::{Error, Result};
 use serde::Serialize;
 
@@ -186,4 +188,35 @@ pub fn plan_field_axes(
         frame_half_deg: frame,
         notes,
     })
+}
+
+/// The directions a frame needs ([`crate::psf::field_plan`]), measured with the grid's
+/// largest pupil at its green wavelength, the eye focused at its first focus state.
+pub fn plan_for_frame(
+    eye: &Eye,
+    axes: &GridAxes,
+    screen: &Screen,
+    width_px: u32,
+) -> Result<FieldPlan> {
+    let pupil_mm = axes.pupils_mm.last().copied().unwrap_or(4.0);
+    let focus = distance_of(axes.focus_d.first().copied().unwrap_or(0.0));
+    let wavelength_nm = axes.wavelengths_nm[1];
+    let focused = match focus {
+        None => eye.clone(),
+        Some(_) => accommodate(eye, focus, pupil_mm, wavelength_nm)?.eye,
+    };
+    let sys = focused.system()?;
+    let probe = Probe {
+        sys: &sys,
+        wavelength_nm,
+        pupil_mm,
+        object_distance_m: focus,
+    };
+    plan_field_axes(
+        &probe,
+        screen.fov_y_deg,
+        width_px,
+        screen.height_px,
+        FIELD_TOLERANCE_UM,
+    )
 }

@@ -141,6 +141,37 @@ pub fn kernels_from_columns(
     settings: &KernelSettings,
     progress: Progress,
 ) -> Result<(KernelGrid, GridReport)> {
+    let psfs = psfs_of_columns(columns, axes, screen, settings, progress)?;
+    let radius = psfs.natural_max_radius_px().ceil() as u32;
+    grid_from_psfs(columns, psfs, axes, screen, settings, progress, radius)
+}
+
+/// The PSFs of a grid's columns, kept as their pixel-integration bins: what the kernels are
+/// made from at any largest radius (grids that share one texture share their largest radius,
+/// so it is chosen only once every PSF is known).
+pub(crate) struct ColumnPsfs {
+    psfs: Vec<PsfSummary>,
+    seconds: f64,
+}
+
+impl ColumnPsfs {
+    /// Largest natural PSF radius over every PSF (px, before any cap).
+    pub fn natural_max_radius_px(&self) -> f64 {
+        self.psfs
+            .iter()
+            .map(|p| p.natural_radius_px)
+            .fold(0.0f64, f64::max)
+    }
+}
+
+/// Every PSF of `columns` (per column, channel and object distance).
+pub(crate) fn psfs_of_columns(
+    columns: &[ColumnOptics],
+    axes: &GridAxes,
+    screen: &Screen,
+    settings: &KernelSettings,
+    progress: Progress,
+) -> Result<ColumnPsfs> {
     screen.validate().map_err(Error::input)?;
     settings.validate().map_err(Error::input)?;
     if columns.len() != axes.pupils_mm.len() * axes.focus_d.len() {
@@ -176,14 +207,36 @@ pub fn kernels_from_columns(
             .collect::<Result<_>>()?;
         psfs.extend(part);
     }
-    let seconds_psfs = t1.elapsed().as_secs_f64();
-    let psf = |s: usize, c: usize, o: usize| &psfs[(s * 3 + c) * no + o];
+    Ok(ColumnPsfs {
+        psfs,
+        seconds: t1.elapsed().as_secs_f64(),
+    })
+}
 
-    let natural_max = psfs
-        .iter()
-        .map(|p| p.natural_radius_px)
-        .fold(0.0f64, f64::max);
-    let max_radius = (natural_max.ceil() as u32).min(settings.max_radius_cap);
+/// The grid of `columns` from their PSFs, with kernels up to `radius_px` (at least every
+/// natural radius, at most the settings' cap).
+pub(crate) fn grid_from_psfs(
+    columns: &[ColumnOptics],
+    summaries: ColumnPsfs,
+    axes: &GridAxes,
+    screen: &Screen,
+    settings: &KernelSettings,
+    progress: Progress,
+    radius_px: u32,
+) -> Result<(KernelGrid, GridReport)> {
+    let no = axes.objects.count;
+    let seconds_psfs = summaries.seconds;
+    let natural_max = summaries.natural_max_radius_px();
+    let psfs = summaries.psfs;
+    if psfs.len() != columns.len() * 3 * no {
+        return Err(Error::input(
+            "one PSF per column, channel and object is required",
+        ));
+    }
+    let psf = |s: usize, c: usize, o: usize| &psfs[(s * 3 + c) * no + o];
+    let max_radius = radius_px
+        .max(natural_max.ceil() as u32)
+        .min(settings.max_radius_cap);
     let clamped_radii = psfs
         .iter()
         .filter(|p| p.natural_radius_px > max_radius as f64)

@@ -7,7 +7,8 @@
 //! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs.
 //! - [`exact`]: exact kernels at any vergence for the ground truth.
 //! - [`field`]: kernels for a direction of the visual field (elliptical pupil);
-//!   [`field_plan`]: which directions a frame needs.
+//!   [`field_plan`]: which directions a frame needs; [`field_kernels`]: the runtime's kernels
+//!   over those directions.
 //! - [`cache`]: grid files and the on-disk cache; [`preview`]: contact sheet and size plot.
 //! - [`kernels`]: the contract with the GPU runtime.
 
@@ -16,6 +17,7 @@ pub mod cache;
 pub mod defocus;
 pub mod exact;
 pub mod field;
+pub mod field_kernels;
 pub mod field_plan;
 pub mod grid;
 pub mod integrate;

@@ -9,7 +9,9 @@ use crate::eye::Eye;
 use crate::gpu::{Context, Timings};
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
 use crate::psf::cache::{self, CacheOutcome};
-use crate::psf::exact::ExactEye;
+use crate::psf::exact::{ExactEye, ExactFieldEye};
+use crate::psf::field_kernels::{compute_kernel_field, KernelField};
+use crate::psf::field_plan::{plan_for_frame, FieldPlan};
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::KernelGrid;
 use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
@@ -61,6 +63,9 @@ pub struct KernelOptions {
     /// Told the stage and count as kernels are computed (the CLI draws a progress bar with it;
     /// the library prints nothing).
     pub progress: Option<ProgressHook>,
+    /// Off-axis kernels for frames this wide (pixels): one grid per direction of a field
+    /// lattice planned from the frame. None: the on-axis PSF everywhere.
+    pub field_width_px: Option<u32>,
 }
 
 /// A progress callback: (stage, done, total).
@@ -73,6 +78,7 @@ impl std::fmt::Debug for KernelOptions {
             .field("reference_axes", &self.reference_axes)
             .field("cache_dir", &self.cache_dir)
             .field("progress", &self.progress.is_some())
+            .field("field_width_px", &self.field_width_px)
             .finish()
     }
 }
@@ -84,6 +90,7 @@ impl Default for KernelOptions {
             reference_axes: GridAxes::default(),
             cache_dir: cache::default_cache_dir(),
             progress: None,
+            field_width_px: None,
         }
     }
 }
@@ -97,9 +104,18 @@ pub struct PreparedKernels {
     pub report: Option<GridReport>,
     pub cache: CacheOutcome,
     pub seconds: f64,
+    /// Off-axis frames: the kernels over the field and how their directions were planned.
+    pub field: Option<FieldKernels>,
     /// What a user must hear about these kernels: PSFs that miss pupil energy beyond the
     /// limit, a cache that could not be written.
     pub warnings: Vec<String>,
+}
+
+/// Kernels over the visual field and the plan of their directions.
+#[derive(Clone)]
+pub struct FieldKernels {
+    pub kernels: KernelField,
+    pub plan: FieldPlan,
 }
 
 /// Smallest and largest object vergence (along each pixel's ray; infinity = 0 D) of a
@@ -149,30 +165,90 @@ pub fn prepare_kernels(
 ) -> Result<PreparedKernels> {
     let started = Instant::now();
     let plan = plan_for_scene(needs, &options.reference_axes).map_err(Error::input)?;
-    let key = cache::grid_key(eye, &plan.axes, &plan.screen, &options.settings);
     let progress = |stage: Stage, done: usize, total: usize| {
         if let Some(hook) = &options.progress {
             hook(stage, done, total);
         }
     };
+    if let Some(width_px) = options.field_width_px {
+        return prepare_field_kernels(eye, plan, width_px, options, started, &progress);
+    }
+    let key = cache::grid_key(eye, &plan.axes, &plan.screen, &options.settings);
     let (grid, report, outcome) = cache::cached(options.cache_dir.as_deref(), &key, || {
         compute_grid(eye, &plan.axes, &plan.screen, &options.settings, &progress)
     })?;
     // a kernel whose PSF misses pupil energy beyond the limit is never silent
     let mut warnings: Vec<String> = report.iter().flat_map(|r| r.warnings.clone()).collect();
-    match &outcome {
-        CacheOutcome::Stored {
-            warning: Some(w), ..
-        } => warnings.push(w.clone()),
-        CacheOutcome::WriteFailed(w) => warnings.push(format!("kernels not cached: {w}")),
-        _ => {}
-    }
+    warnings.extend(cache_warning(&outcome));
     Ok(PreparedKernels {
         grid,
         plan,
         report,
         cache: outcome,
         seconds: started.elapsed().as_secs_f64(),
+        field: None,
+        warnings,
+    })
+}
+
+fn cache_warning(outcome: &CacheOutcome) -> Option<String> {
+    match outcome {
+        CacheOutcome::Stored {
+            warning: Some(w), ..
+        } => Some(w.clone()),
+        CacheOutcome::WriteFailed(w) => Some(format!("kernels not cached: {w}")),
+        _ => None,
+    }
+}
+
+/// Off-axis: the field lattice the frame needs, then every node's grid (one largest radius).
+/// `grid` is the node nearest the axis (what on-axis consumers of the kernels read).
+fn prepare_field_kernels(
+    eye: &Eye,
+    plan: Plan,
+    width_px: u32,
+    options: &KernelOptions,
+    started: Instant,
+    progress: &(dyn Fn(Stage, usize, usize) + Sync),
+) -> Result<PreparedKernels> {
+    let field_plan = plan_for_frame(eye, &plan.axes, &plan.screen, width_px)?;
+    let out = compute_kernel_field(
+        eye,
+        &plan.axes,
+        &plan.screen,
+        &options.settings,
+        &field_plan.axes,
+        options.cache_dir.as_deref(),
+        progress,
+    )?;
+    let mut warnings: Vec<String> = Vec::new();
+    for (node, r) in field_plan.axes.nodes().iter().zip(&out.reports) {
+        for w in &r.warnings {
+            warnings.push(format!("field ({}, {})°: {w}", node[0], node[1]));
+        }
+    }
+    warnings.extend(field_plan.notes.iter().cloned());
+    warnings.extend(cache_warning(&out.cache));
+    let centre = out.field.weights([0.0, 0.0]);
+    let nearest = centre
+        .iter()
+        .copied()
+        .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
+        .0;
+    Ok(PreparedKernels {
+        grid: out.field.grids[nearest].clone(),
+        plan,
+        // the nearest node's report, counting every node's PSFs
+        report: out.reports.get(nearest).cloned().map(|mut r| {
+            r.psfs_computed = out.reports.iter().map(|r| r.psfs_computed).sum();
+            r
+        }),
+        cache: out.cache,
+        seconds: started.elapsed().as_secs_f64(),
+        field: Some(FieldKernels {
+            kernels: out.field,
+            plan: field_plan,
+        }),
         warnings,
     })
 }
@@ -197,7 +273,13 @@ pub struct FrameRenderer {
     splat_settings: SplatSettings,
     splatter: Option<Splatter>,
     pub slice_count: usize,
+    /// Off axis, the reference traces the eye for every field bin of this many degrees.
+    pub reference_field_step_deg: f64,
 }
+
+/// Default field bin of the off-axis reference (degrees): a tenth of a typical lattice step,
+/// well inside the λ/14 interpolation tolerance the lattice is planned to.
+pub const REFERENCE_FIELD_STEP_DEG: f64 = 1.0;
 
 impl FrameRenderer {
     pub fn new(
@@ -215,6 +297,7 @@ impl FrameRenderer {
             splat_settings,
             splatter: None,
             slice_count: slices::DEFAULT_SLICES,
+            reference_field_step_deg: REFERENCE_FIELD_STEP_DEG,
         }
     }
 
@@ -247,11 +330,16 @@ impl FrameRenderer {
             )),
             Method::Splat => {
                 if self.splatter.is_none() {
-                    self.splatter = Some(Splatter::new(
-                        &self.ctx,
-                        self.kernels.grid.clone(),
-                        self.splat_settings,
-                    )?);
+                    self.splatter = Some(match &self.kernels.field {
+                        None => Splatter::new(
+                            &self.ctx,
+                            self.kernels.grid.clone(),
+                            self.splat_settings,
+                        )?,
+                        Some(f) => {
+                            Splatter::new_field(&self.ctx, f.kernels.clone(), self.splat_settings)?
+                        }
+                    });
                 }
                 let splatter = self.splatter.as_mut().expect("just created");
                 let out = splatter.render(
@@ -280,7 +368,17 @@ impl FrameRenderer {
                     self.settings.clone(),
                     self.kernels.grid.max_radius_px,
                 )?;
-                let color = if method == Method::Reference {
+                let color = if let (Some(_), Method::Reference) = (&self.kernels.field, method) {
+                    let wavelengths = self.kernels.grid.wavelengths_nm;
+                    let field =
+                        ExactFieldEye::new(exact, wavelengths, self.reference_field_step_deg)?;
+                    reference::render(input, &field)
+                } else if self.kernels.field.is_some() {
+                    return Err(Error::input(
+                        "--off-axis applies to --method splat and reference; slices use one PSF \
+                         per depth slice",
+                    ));
+                } else if method == Method::Reference {
                     reference::render(input, &exact)
                 } else {
                     slices::render(input, &exact, self.slice_count)

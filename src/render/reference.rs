@@ -53,9 +53,28 @@ pub fn render_with(
     } else {
         input.depth_m.iter().map(|&d| dioptre_of_depth(d)).collect()
     };
-    let bins: Vec<i64> = dioptres.iter().map(|&d| bin_of(d)).collect();
+    // Off axis each pixel also has a field bin: (h, v) rounded to the source's field step.
+    let field_bins: Vec<(i64, i64)> = match kernels.field_step_deg() {
+        None => vec![(0, 0); w * h],
+        Some(step) => {
+            let f = projection.focal_px();
+            (0..w * h)
+                .map(|i| {
+                    let x = ((i % w) as f64 + 0.5 - 0.5 * w as f64) / f;
+                    let y = -((i / w) as f64 + 0.5 - 0.5 * h as f64) / f;
+                    let bin = |u: f64| (u.atan().to_degrees() / step).round() as i64;
+                    (bin(x), bin(y))
+                })
+                .collect()
+        }
+    };
+    let bins: Vec<Bin> = dioptres
+        .iter()
+        .zip(&field_bins)
+        .map(|(&d, &(fh, fv))| (bin_of(d), fh, fv))
+        .collect();
     let kernel_table = exact_kernels_for(&bins, kernels);
-    let lookup = |channel: usize, bin: i64| -> &Kernel { &kernel_table[&(channel, bin)] };
+    let lookup = |channel: usize, bin: Bin| -> &Kernel { &kernel_table[&(channel, bin)] };
     let scales: Vec<LocalScale> = (0..w * h)
         .map(|i| {
             if wide {
@@ -157,24 +176,31 @@ pub fn render_with(
     image
 }
 
+/// A pixel's kernel bin: dioptre bin, then field bins along h and v (0 on axis).
+type Bin = (i64, i64, i64);
+
 /// Computes each distinct (channel, bin) kernel once, in parallel.
 fn exact_kernels_for(
-    bins: &[i64],
+    bins: &[Bin],
     kernels: &dyn ExactKernels,
-) -> HashMap<(usize, i64), Arc<Kernel>> {
-    let mut distinct: Vec<i64> = bins.to_vec();
+) -> HashMap<(usize, Bin), Arc<Kernel>> {
+    let mut distinct: Vec<Bin> = bins.to_vec();
     distinct.sort_unstable();
     distinct.dedup();
-    let jobs: Vec<(usize, i64)> = distinct
+    let jobs: Vec<(usize, Bin)> = distinct
         .iter()
         .flat_map(|&b| (0..3).map(move |c| (c, b)))
         .collect();
+    let step = kernels.field_step_deg().unwrap_or(0.0);
+    let mut fields: Vec<(i64, i64)> = distinct.iter().map(|b| (b.1, b.2)).collect();
+    fields.sort_unstable();
+    fields.dedup();
+    kernels.prepare_field_bins(&fields);
     jobs.into_par_iter()
         .map(|(c, b)| {
-            (
-                (c, b),
-                Arc::new(kernels.kernel(c, b as f64 * DIOPTRE_BIN_D)),
-            )
+            let field = [b.1 as f64 * step, b.2 as f64 * step];
+            let k = kernels.kernel_in_field(c, b.0 as f64 * DIOPTRE_BIN_D, field);
+            ((c, b), Arc::new(k))
         })
         .collect()
 }

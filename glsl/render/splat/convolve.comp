@@ -7,19 +7,22 @@
 // A += (1 − A)·min(Ag, 1); the output is C / A. (blend_mode 1: the seed paper's per-fragment
 // C += (1 − A)·w·c, A += (1 − A)·w.) The kernel weight w comes from two trilinear lookups in
 // the PSF texture (floor and ceiling radius; the layer axis blends the two neighbouring object
-// distances), mixed by frac(radius), at the kernel offset of the local pinhole scale.
+// distances), mixed by frac(radius), at the kernel offset of the local pinhole scale; off axis,
+// the kernels of the four field nodes around the fragment, mixed bilinearly (glsl/common/field.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "splat.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
-FRAGMENT_BUFFERS(1, 6, 7, 8, readonly)
+FRAGMENT_BUFFERS(1, 7, 8, 9, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 3) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 4) readonly buffer Entries { uvec2 entries[]; };
 layout(binding = 5, rgba32f) writeonly uniform image2D color_out;
+layout(std430, binding = 6) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
+#include "field.glsl"
 
 // The tile side is fixed per pipeline, so the per-thread pixel arrays have a compile-time
 // size and live in registers (dynamic sizes cost CPU implementations such as lavapipe dearly).
@@ -31,22 +34,25 @@ const uint PIXELS = PER_AXIS * PER_AXIS;
 shared vec4 batch_reach[64];   // centre.xy, reach, 1 when the local scale applies
 shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shrink
 shared Fragment batch[64];
+shared uvec4 batch_nodes[64];  // off axis: the four field nodes around the fragment
+shared vec4 batch_node_weights[64];
 shared uint unsaturated;       // threads with a pixel whose closed groups cover < 1 − ε
 
-// RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block).
-vec3 kernel_rgb(vec2 d, float l, float index) {
-    float side = float(2u * frame.max_radius + 1u);
+// RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block), from
+// the tile at texel `origin` (one per field node).
+vec3 kernel_rgb(vec2 d, float l, float index, vec2 origin) {
+    vec2 extent = field_header[0].xy * field_header[0].z;
     float layers = float(frame.object_count * level_count());
-    vec3 uvw = vec3((float(frame.max_radius) + 0.5 + d) / side,
+    vec3 uvw = vec3((origin + float(frame.max_radius) + 0.5 + d) / extent,
                     (l * float(frame.object_count) + index + 0.5) / layers);
     float k = float(2u * level_block_radius(uint(l)) + 1u);
     return textureLod(psf_texture, uvw, 0.0).rgb / (k * k);
 }
 
-// Per-channel weight of fragment f at offset d: each channel's radius lies between two radius
-// levels; when all channels' levels fall within three consecutive ones (the usual case), the
-// three lookups serve every channel, else each channel takes its own two.
-vec3 fragment_weight(Fragment f, vec2 d) {
+// Per-channel kernel of fragment f at offset d in the tile at `origin`: each channel's radius
+// lies between two radius levels; when all channels' levels fall within three consecutive ones
+// (the usual case), the three lookups serve every channel, else each channel takes its own two.
+vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
     vec3 t = level - lo;
@@ -54,9 +60,9 @@ vec3 fragment_weight(Fragment f, vec2 d) {
     float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
     vec3 w;
     if (top - base <= 2.0) {
-        vec3 s0 = kernel_rgb(d, base, f.index);
-        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index) : s0;
-        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index) : s1;
+        vec3 s0 = kernel_rgb(d, base, f.index, origin);
+        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index, origin) : s0;
+        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index, origin) : s1;
         // Component-wise selection (no dynamic indexing): channel c reads s[i0] and s[i0 + 1].
         vec3 i0 = lo - base;
         vec3 a = mix(mix(s0, s1, step(0.5, i0)), s2, step(1.5, i0));
@@ -64,8 +70,27 @@ vec3 fragment_weight(Fragment f, vec2 d) {
         w = mix(a, b, t);
     } else {
         for (int c = 0; c < 3; c++) {
-            float a = kernel_rgb(d, lo[c], f.index)[c];
-            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index)[c], t[c]) : a;
+            float a = kernel_rgb(d, lo[c], f.index, origin)[c];
+            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, origin)[c], t[c]) : a;
+        }
+    }
+    return w;
+}
+
+// Per-channel weight of batch fragment j at offset d: off axis, the four field nodes' kernels
+// at the fragment's radius, mixed bilinearly in field angle.
+vec3 fragment_weight(uint j, Fragment f, vec2 d) {
+    vec3 w;
+    if (field_nodes() == 1u) {
+        w = kernel_at(f, d, vec2(0.0));
+    } else {
+        w = vec3(0.0);
+        uvec4 nodes = batch_nodes[j];
+        vec4 weights = batch_node_weights[j];
+        for (uint k = 0u; k < 4u; k++) {
+            if (weights[k] > 0.0) {
+                w += weights[k] * kernel_at(f, d, node_origin(nodes[k]));
+            }
         }
     }
     if (f.size > 1u) {
@@ -115,6 +140,13 @@ void main() {
         if (start + local_index < n) {
             Fragment f = load_fragment(entries[base + start + local_index].y);
             batch[local_index] = f;
+            if (field_nodes() > 1u) {
+                uvec4 nodes;
+                vec4 weights;
+                field_corners(f.center, nodes, weights);
+                batch_nodes[local_index] = nodes;
+                batch_node_weights[local_index] = weights;
+            }
             vec3 s = local_scale(f.center);
             // The largest channel radius decides how much of the local scale applies.
             float r = max(f.radius.r, max(f.radius.g, f.radius.b));
@@ -135,9 +167,9 @@ void main() {
                 vec3 w;
                 if (g.w > 0.5) {
                     vec4 s = batch_scale[j];
-                    w = fragment_weight(f, kernel_offset(s.xy, s.zw, d)) * (s.z * s.w);
+                    w = fragment_weight(j, f, kernel_offset(s.xy, s.zw, d)) * (s.z * s.w);
                 } else {
-                    w = fragment_weight(f, d);
+                    w = fragment_weight(j, f, d);
                 }
                 if (grouped) {
                     if (last[q] >= 0.0 && abs(f.dioptre - last[q]) > frame.group_tolerance_d) {

@@ -1,6 +1,7 @@
 #version 460
 // One fragment per pixel: colour, distance along the ray, continuous index on the object-dioptre axis and the
-// blur radius per channel, interpolated between the two neighbouring object distances.
+// blur radius per channel, interpolated between the two neighbouring object distances (and,
+// off axis, between the four neighbouring field nodes).
 #extension GL_GOOGLE_include_directive : require
 #include "splat.glsl"
 
@@ -10,8 +11,11 @@ layout(binding = 0, rgba32f) readonly uniform image2D color_in;
 layout(binding = 1, r32f) readonly uniform image2D depth_in;
 // Natural radius per object distance, per channel (xyz), of this frame's blended kernels.
 layout(std430, binding = 2) readonly buffer Radii { vec4 radii[]; };
-FRAGMENT_BUFFERS(3, 4, 5, 6, writeonly)
+FRAGMENT_BUFFERS(3, 5, 6, 7, writeonly)
 FRAGMENT_STORE
+// Per field node, the same radii (on axis: one node, equal to `radii`).
+layout(std430, binding = 4) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
+#include "field.glsl"
 
 void main() {
     uvec2 g = gl_GlobalInvocationID.xy;
@@ -34,7 +38,15 @@ void main() {
     float index = clamp((dioptre - frame.dioptre_min) / frame.dioptre_step, 0.0, last);
     uint i0 = uint(floor(index));
     uint i1 = min(i0 + 1u, frame.object_count - 1u);
-    vec3 radius = mix(radii[i0].xyz, radii[i1].xyz, index - float(i0));
+    // Off axis, the radius is the bilinear mix over the four field nodes around the pixel.
+    uvec4 nodes;
+    vec4 weights;
+    field_corners(vec2(p) + 0.5, nodes, weights);
+    vec3 radius = vec3(0.0);
+    for (uint k = 0u; k < 4u; k++) {
+        uint b = nodes[k] * frame.object_count;
+        radius += weights[k] * mix(node_radii[b + i0].xyz, node_radii[b + i1].xyz, index - float(i0));
+    }
 
     Fragment f;
     f.color = color;

@@ -16,11 +16,15 @@ layout(std430, binding = 2) readonly buffer Set2 { float set2[]; };
 layout(std430, binding = 3) readonly buffer Set3 { float set3[]; };
 layout(binding = 4) writeonly uniform image3D psf_texture;
 
-// pass_f: the four corner weights; pass_u: (first level, end level, first texel) of the chunk.
+// pass_f: the four corner weights; pass_u: (first level, end level, first texel) of the chunk,
+// and the field node's tile: column | row << 10 | data offset << 20 (src/render/splat/field.rs).
+// A tile is pitch = side + 2·offset texels square, its kernels start `offset` texels in: off
+// axis a zero margin keeps bilinear reads at a kernel's edge out of the neighbouring tile.
 #define WEIGHTS frame.pass_f
 #define FIRST_LEVEL frame.pass_u.x
 #define END_LEVEL frame.pass_u.y
 #define FIRST_TEXEL frame.pass_u.z
+#define TILE_CODE frame.pass_u.w
 
 uint texels_below(uint r) {
     return r * (4u * r * r - 1u) / 3u;
@@ -46,16 +50,19 @@ uint texels_below_level(uint level) {
 
 void main() {
     uint side = 2u * frame.max_radius + 1u;
+    uint offset = TILE_CODE >> 20u;
+    uint pitch = side + 2u * offset;
+    uvec2 tile = uvec2(TILE_CODE & 1023u, (TILE_CODE >> 10u) & 1023u);
     uvec3 id = gl_GlobalInvocationID;
     uint layer = FIRST_LEVEL * frame.object_count + id.z;
-    if (id.x >= side || id.y >= side || layer >= END_LEVEL * frame.object_count) {
+    if (id.x >= pitch || id.y >= pitch || layer >= END_LEVEL * frame.object_count) {
         return;
     }
     uint level = layer / frame.object_count;
     uint r = level_block_radius(level);
     uint o = layer % frame.object_count;
-    int dx = int(id.x) - int(frame.max_radius);
-    int dy = int(id.y) - int(frame.max_radius);
+    int dx = int(id.x) - int(offset + frame.max_radius);
+    int dy = int(id.y) - int(offset + frame.max_radius);
     vec3 value = vec3(0.0);
     if (abs(dx) <= int(r) && abs(dy) <= int(r)) {
         uint kside = 2u * r + 1u;
@@ -68,5 +75,5 @@ void main() {
         if (WEIGHTS.w > 0.0) value += WEIGHTS.w * vec3(set3[i], set3[i + 1u], set3[i + 2u]);
         value *= float(kside * kside);
     }
-    imageStore(psf_texture, ivec3(id.xy, layer), vec4(value, 0.0));
+    imageStore(psf_texture, ivec3(tile * pitch + id.xy, layer), vec4(value, 0.0));
 }

@@ -24,6 +24,7 @@ impl ConvolvePass {
                         BindingKind::StorageBuffer,
                         BindingKind::StorageBuffer,
                         BindingKind::StorageImage,
+                        BindingKind::StorageBuffer,
                     ],
                 ))
                 .push_constants::<FrameParams>()
@@ -39,6 +40,7 @@ impl ConvolvePass {
         params: &FrameParams,
         band_tiles: u32,
         psf: (&Image, &Sampler),
+        field_table: &Buffer,
         fragments: &FragmentStore,
         counts: &Buffer,
         offsets: &Buffer,
@@ -54,6 +56,7 @@ impl ConvolvePass {
                     Binding::Buffer(offsets),
                     Binding::Buffer(entries),
                     Binding::Storage(output),
+                    Binding::Buffer(field_table),
                 ],
             ),
             params,

@@ -111,7 +111,7 @@ impl FragmentsPass {
                         BindingKind::StorageImage,
                         BindingKind::StorageBuffer,
                     ],
-                    &[],
+                    &[BindingKind::StorageBuffer],
                 ))
                 .push_constants::<FrameParams>()
                 .build(ctx)?;
@@ -125,6 +125,7 @@ impl FragmentsPass {
         color: &Image,
         depth: &Image,
         radii: &Buffer,
+        field_table: &Buffer,
         fragments: &FragmentStore,
     ) -> GpuResult<()> {
         rec.dispatch(
@@ -135,7 +136,7 @@ impl FragmentsPass {
                     Binding::Storage(depth),
                     Binding::Buffer(radii),
                 ],
-                &[],
+                &[Binding::Buffer(field_table)],
             ),
             params,
             [

@@ -9,6 +9,7 @@
 //! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`.
 
 mod convolve;
+mod field;
 mod fragments;
 mod merge;
 mod prefix_sum;
@@ -275,8 +276,15 @@ struct FrameResources {
 pub struct Splatter {
     ctx: Context,
     settings: SplatSettings,
+    /// On axis the grid; off axis the node nearest the axis (axes and radius are shared).
     grid: KernelGrid,
-    resident: psf_texture::ResidentGrid,
+    /// Off axis: every field node's grid (h-major) and the lattice; on axis empty and None.
+    node_grids: Vec<KernelGrid>,
+    field_axes: Option<crate::psf::field::FieldAxes>,
+    /// Per node (on axis one), every kernel set resident on the GPU.
+    resident: Vec<psf_texture::ResidentGrid>,
+    layout: field::TextureLayout,
+    field_table: field::FieldTable,
     texture: Image,
     sampler: Sampler,
     radii: Buffer,
@@ -321,17 +329,76 @@ impl Splatter {
         grid: KernelGrid,
         settings: SplatSettings,
     ) -> crate::Result<Splatter> {
-        settings.validate().map_err(crate::Error::Input)?;
         grid.validate()
             .map_err(|e| crate::Error::Input(format!("kernel grid: {e}")))?;
+        Self::build(ctx, grid, Vec::new(), None, settings)
+    }
+
+    /// Off axis: every node's grid resident, one PSF-texture tile per node, and each
+    /// fragment's kernel mixed from the four nodes around its direction.
+    pub fn new_field(
+        ctx: &Context,
+        field: crate::psf::field_kernels::KernelField,
+        settings: SplatSettings,
+    ) -> crate::Result<Splatter> {
+        field
+            .validate()
+            .map_err(|e| crate::Error::Input(format!("field kernels: {e}")))?;
+        let centre = field.weights([0.0, 0.0]);
+        let nearest = centre
+            .iter()
+            .copied()
+            .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
+            .0;
+        let grid = field.grids[nearest].clone();
+        Self::build(ctx, grid, field.grids, Some(field.axes), settings)
+    }
+
+    fn build(
+        ctx: &Context,
+        grid: KernelGrid,
+        node_grids: Vec<KernelGrid>,
+        field_axes: Option<crate::psf::field::FieldAxes>,
+        settings: SplatSettings,
+    ) -> crate::Result<Splatter> {
+        settings.validate().map_err(crate::Error::Input)?;
         if !ctx.can_write_images_without_format() {
             return Err(GpuError::Unsupported(
                 "shaderStorageImageWriteWithoutFormat (needed to build the PSF texture)".into(),
             )
             .into());
         }
-        let resident = psf_texture::ResidentGrid::upload(ctx, &grid)?;
-        let texture = psf_texture::create_texture(ctx, &grid, settings.texture_format)?;
+        let layout = field::TextureLayout::new(&grid, field_axes.as_ref());
+        let texel_bytes = match settings.texture_format {
+            PsfTextureFormat::Rgba16Float => 8,
+            PsfTextureFormat::Rgba32Float => 16,
+        };
+        layout.check(ctx, texel_bytes)?;
+        let nodes: &[KernelGrid] = if node_grids.is_empty() {
+            std::slice::from_ref(&grid)
+        } else {
+            &node_grids
+        };
+        let resident = nodes
+            .iter()
+            .map(|g| psf_texture::ResidentGrid::upload(ctx, g))
+            .collect::<crate::gpu::GpuResult<Vec<_>>>()?;
+        // Merging decides on the core radius: off axis the smallest over the nodes, so that a
+        // block merges only where every node's kernel allows it.
+        let mut core_radii: Vec<Vec<[f32; 3]>> =
+            grid.sets.iter().map(|s| s.core_radii_px()).collect();
+        for g in nodes {
+            for (mine, theirs) in core_radii.iter_mut().zip(&g.sets) {
+                for (m, t) in mine.iter_mut().zip(theirs.core_radii_px()) {
+                    for c in 0..3 {
+                        m[c] = m[c].min(t[c]);
+                    }
+                }
+            }
+        }
+        let texture = psf_texture::create_texture(ctx, layout.extent(), settings.texture_format)?;
+        let field_table =
+            field::FieldTable::new(ctx, &layout, field_axes.as_ref(), grid.objects.count)?;
         let radii = Buffer::new(
             ctx,
             "object radii",
@@ -342,6 +409,10 @@ impl Splatter {
             ctx: ctx.clone(),
             settings,
             resident,
+            layout,
+            field_table,
+            node_grids,
+            field_axes,
             texture,
             sampler: Sampler::linear(ctx, Edge::ZeroBorder)?,
             radii,
@@ -354,7 +425,7 @@ impl Splatter {
             texture_blend: None,
             last_lists: None,
             allocations: 0,
-            core_radii: grid.sets.iter().map(|s| s.core_radii_px()).collect(),
+            core_radii,
             frame: None,
             entries: None,
             psf_texture: psf_texture::PsfTexturePass::new(ctx)?,
@@ -367,6 +438,20 @@ impl Splatter {
             convolve: convolve::ConvolvePass::new(ctx, settings.tile_size)?,
             grid,
         })
+    }
+
+    /// Every field node's grid (on axis: the grid alone).
+    fn nodes(&self) -> &[KernelGrid] {
+        if self.node_grids.is_empty() {
+            std::slice::from_ref(&self.grid)
+        } else {
+            &self.node_grids
+        }
+    }
+
+    /// The field lattice of off-axis kernels (None on axis).
+    pub fn field_axes(&self) -> Option<&crate::psf::field::FieldAxes> {
+        self.field_axes.as_ref()
     }
 
     pub fn grid(&self) -> &KernelGrid {
@@ -571,8 +656,11 @@ impl Splatter {
             }
             write_mapped(&mut self.radii_staging, &radii);
         }
-        let upload_bytes =
-            (pixels * 20 * (1 + input.hidden_layers.len()) + radii.len() * 16) as u64;
+        let table = self.field_table.contents(self.nodes(), &blend);
+        write_mapped(&mut self.field_table.staging, &table);
+        let upload_bytes = (pixels * 20 * (1 + input.hidden_layers.len())
+            + radii.len() * 16
+            + table.len() * 16) as u64;
         let frame = self.frame.as_ref().expect("ensured above");
         let mut params = self.params(frame);
         params.focal_px = input.projection().focal_px() as f32;
@@ -756,10 +844,18 @@ impl Splatter {
         rec.copy_buffer_to_image(&frame.staging_color, &frame.color_in);
         rec.copy_buffer_to_image(&frame.staging_depth, &frame.depth_in);
         rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
+        rec.copy_buffer(
+            &self.field_table.staging,
+            &self.field_table.buffer,
+            self.field_table.buffer.size_bytes(),
+        );
         if rebuild_texture {
             rec.begin_pass("psf texture");
-            self.psf_texture
-                .record(rec, params, &self.resident, blend, &self.texture)?;
+            for (node, resident) in self.resident.iter().enumerate() {
+                let tile = self.layout.tile_code(node);
+                self.psf_texture
+                    .record(rec, params, resident, blend, tile, &self.texture)?;
+            }
         }
         rec.begin_pass("fragments");
         self.fragments_pass.record(
@@ -768,6 +864,7 @@ impl Splatter {
             &frame.color_in,
             &frame.depth_in,
             &self.radii,
+            &self.field_table.buffer,
             &frame.fragments,
         )?;
         if self.settings.merge.levels > 0 {
@@ -830,6 +927,7 @@ impl Splatter {
             params,
             band_tiles,
             (&self.texture, &self.sampler),
+            &self.field_table.buffer,
             &frame.fragments,
             &frame.counts,
             &frame.offsets,

@@ -33,32 +33,16 @@ impl PsfTextureFormat {
     }
 }
 
-/// Extent of the PSF texture for a grid: (2Rmax+1)² × No·(Rmax+1).
-pub fn texture_extent(grid: &KernelGrid) -> [u32; 3] {
-    let side = 2 * grid.max_radius_px + 1;
-    [
-        side,
-        side,
-        grid.objects.count as u32 * level_count(grid.max_radius_px),
-    ]
-}
-
 pub(super) fn create_texture(
     ctx: &Context,
-    grid: &KernelGrid,
+    extent: [u32; 3],
     format: PsfTextureFormat,
 ) -> GpuResult<Image> {
     let usage = ImageUsage {
         storage: true,
         ..ImageUsage::SAMPLED
     };
-    Image::new_3d(
-        ctx,
-        "PSF texture",
-        texture_extent(grid),
-        format.texel_format(),
-        usage,
-    )
+    Image::new_3d(ctx, "PSF texture", extent, format.texel_format(), usage)
 }
 
 /// One set's texels for the radii [first_level, end_level), small enough for one binding.
@@ -162,9 +146,11 @@ impl PsfTexturePass {
         params: &FrameParams,
         grid: &ResidentGrid,
         blend: &GridBlend,
+        tile_code: u32,
         texture: &Image,
     ) -> GpuResult<()> {
-        let [side, _, _] = texture.extent();
+        // the tile's pitch: side + 2·margin (see glsl/render/splat/psf_texture.comp)
+        let side = 2 * params.max_radius + 1 + 2 * (tile_code >> 20);
         let chunks = grid.sets[blend.corners[0].0].len();
         for chunk in 0..chunks {
             // Unused corners repeat the first one with weight zero (never read).
@@ -173,7 +159,12 @@ impl PsfTexturePass {
             let weight = |k: usize| blend.corners.get(k).map_or(0.0, |c| c.1 as f32);
             let first = corner(0);
             let mut p = *params;
-            p.pass_u = [first.first_level, first.end_level, first.first_texel, 0];
+            p.pass_u = [
+                first.first_level,
+                first.end_level,
+                first.first_texel,
+                tile_code,
+            ];
             p.pass_f = [weight(0), weight(1), weight(2), weight(3)];
             let layers = (first.end_level - first.first_level) * params.object_count;
             rec.dispatch(
