@@ -24,6 +24,10 @@ pub const MSAA_SAMPLES: u32 = 4;
 /// Depth layers a scene is peeled to for splat unless told otherwise (README: measured).
 pub const DEFAULT_LAYERS: u32 = 1;
 
+/// Bytes of uniforms a frame sends the device (its only host→device data once the scene is
+/// resident).
+pub const FRAME_UNIFORM_BYTES: u64 = std::mem::size_of::<FrameUniform>() as u64;
+
 /// A rendered frame on the CPU: row-major, top row first.
 #[derive(Clone, Debug)]
 pub struct Frame {
@@ -675,7 +679,7 @@ impl RecordedInput for SceneFrame<'_, '_> {
             camera.position_m,
             None,
         )?;
-        Ok(std::mem::size_of::<FrameUniform>() as u64)
+        Ok(FRAME_UNIFORM_BYTES)
     }
 
     fn record<'a>(
