@@ -317,7 +317,10 @@ fn a_steady_scene_frame_is_one_submission_and_uploads_no_pixels() {
     };
     let first = frame();
     eprintln!("first scene frame: {:?}", first.stats);
-    assert!(first.stats.allocations > 0, "the first frame made its targets");
+    assert!(
+        first.stats.allocations > 0,
+        "the first frame made its targets"
+    );
     for _ in 0..2 {
         let allocations_before = ctx.allocations();
         let next = frame();
@@ -329,8 +332,16 @@ fn a_steady_scene_frame_is_one_submission_and_uploads_no_pixels() {
         assert!(next.stats.upload_bytes <= UPLOAD_BOUND);
         let image_bytes = u64::from(SCENE_W * SCENE_H) * 16;
         assert_eq!(next.stats.readback_bytes, image_bytes + 8);
-        let passes: Vec<&str> = next.timings.passes.iter().map(|p| p.name.as_str()).collect();
-        assert!(passes.contains(&"raster") && passes.contains(&"convolve"), "{passes:?}");
+        let passes: Vec<&str> = next
+            .timings
+            .passes
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect();
+        assert!(
+            passes.contains(&"raster") && passes.contains(&"convolve"),
+            "{passes:?}"
+        );
         assert_eq!(next.color, first.color);
     }
     let mut via_host = Splatter::new(&ctx, scene_grid(), SplatSettings::default()).unwrap();

@@ -1,7 +1,8 @@
 //! `ocular bench`: the GPU timing harness. A scene's frame is drawn and splatted M times after
-//! N warm-up frames, the draw in splat's own submission (the frame stays on the GPU); every pass is timed with GPU timestamp queries, and mean / median /
-//! p95 are reported per pass and for the total, beside the precomputation times, in the layout
-//! of the seed paper's Table 3. `--compare-methods` adds the ground truth and the slice method.
+//! N warm-up frames, the draw in splat's own submission (the frame stays on the GPU); every
+//! pass is timed with GPU timestamp queries, and mean / median / p95 are reported per pass and
+//! for the total, beside the precomputation times, in the layout of the seed paper's Table 3.
+//! `--compare-methods` adds the ground truth and the slice method.
 
 use std::path::PathBuf;
 use std::time::Instant;

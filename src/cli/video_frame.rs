@@ -127,4 +127,3 @@ pub(super) fn compose(
     }
     image
 }
-

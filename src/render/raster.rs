@@ -7,13 +7,16 @@
 //! across an edge. Pixels no object covers get the background colour and depth `far_m`.
 //! Colour is 32-bit float throughout: values are cd/m², and lamps, the sun and specular
 //! emitters exceed half float's 65504 (a half-float target clipped them silently).
+//!
+//! A frame is either read back (`render`, `render_layers`: inputs for the host) or recorded
+//! into another submission and left on the GPU (`scene_frame`, splat's input): both go
+//! through the same `prepare` (uniforms through a persistent mapping) and `record`.
 
 use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
     GraphicsPipeline, Image, ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings,
     VertexAttribute, VertexFormat,
 };
-use crate::render::splat::RecordedInput;
 use crate::image_io::{ImageGray, ImageRgba};
 use crate::scene::{FrameState, Light, Vertex, MAX_LIGHTS};
 use crate::{Error, Result};
@@ -456,7 +459,14 @@ impl Rasterizer {
         peel: Option<(&[f32], f32)>,
     ) -> Result<Frame> {
         let gap_d = peel.map(|(_, gap)| gap);
-        self.prepare(ctx, state, (width, height), view_proj, eye_position_m, gap_d)?;
+        self.prepare(
+            ctx,
+            state,
+            (width, height),
+            view_proj,
+            eye_position_m,
+            gap_d,
+        )?;
         let targets = self.targets.as_ref().expect("prepared");
         if let Some((previous, _)) = peel {
             targets.previous_depth.upload(ctx, previous)?;
@@ -465,12 +475,18 @@ impl Rasterizer {
             self.record(rec, state, peel.is_some())?;
             rec.begin_pass("read back");
             rec.copy_image_to_buffer(&targets.color, &targets.color_readback);
-            rec.copy_buffer(&targets.depth, &targets.depth_readback, targets.depth.size_bytes());
+            rec.copy_buffer(
+                &targets.depth,
+                &targets.depth_readback,
+                targets.depth.size_bytes(),
+            );
             Ok(())
         })?;
         let pixels = width as usize * height as usize;
         let mapped = |b: &Buffer, bytes: usize| {
-            b.mapped_bytes().expect("read-back buffers are host-visible")[..bytes].to_vec()
+            b.mapped_bytes()
+                .expect("read-back buffers are host-visible")[..bytes]
+                .to_vec()
         };
         Ok(Frame {
             width,
@@ -631,50 +647,21 @@ impl Rasterizer {
         Ok(())
     }
 
-    /// `state`'s frame as an input splat records into its own submission: the scene is drawn
-    /// there and splat reads the targets, so no pixel crosses to the host and back.
-    pub fn scene_frame<'r, 's>(
-        &'r mut self,
-        ctx: &'r Context,
-        state: &'r FrameState<'s>,
+    /// Prepares `state`'s frame, seen by its own camera at `width`×`height`, for recording
+    /// into another submission; returns the bytes it wrote for the device.
+    pub(crate) fn prepare_camera_frame(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
         (width, height): (u32, u32),
-    ) -> SceneFrame<'r, 's> {
-        SceneFrame {
-            raster: self,
+    ) -> Result<u64> {
+        let camera = &state.camera;
+        let aspect = f64::from(width) / f64::from(height);
+        let view_proj = self.view_projection(camera, aspect);
+        self.prepare(
             ctx,
             state,
-            width,
-            height,
-        }
-    }
-}
-
-/// A scene frame drawn inside splat's submission ([`Rasterizer::scene_frame`]).
-pub struct SceneFrame<'r, 's> {
-    raster: &'r mut Rasterizer,
-    ctx: &'r Context,
-    state: &'r FrameState<'s>,
-    width: u32,
-    height: u32,
-}
-
-impl RecordedInput for SceneFrame<'_, '_> {
-    fn size(&self) -> (u32, u32) {
-        (self.width, self.height)
-    }
-
-    fn fov_y_deg(&self) -> f64 {
-        self.state.camera.fov_y_deg
-    }
-
-    fn prepare(&mut self) -> Result<u64> {
-        let camera = &self.state.camera;
-        let aspect = f64::from(self.width) / f64::from(self.height);
-        let view_proj = self.raster.view_projection(camera, aspect);
-        self.raster.prepare(
-            self.ctx,
-            self.state,
-            (self.width, self.height),
+            (width, height),
             view_proj,
             camera.position_m,
             None,
@@ -682,12 +669,14 @@ impl RecordedInput for SceneFrame<'_, '_> {
         Ok(FRAME_UNIFORM_BYTES)
     }
 
-    fn record<'a>(
-        &'a self,
+    /// Records the prepared frame; returns where it leaves the colour and the depth.
+    pub(crate) fn record_frame(
+        &self,
         rec: &mut Recorder<'_>,
-    ) -> crate::gpu::GpuResult<(&'a Image, &'a Buffer)> {
-        self.raster.record(rec, self.state, false)?;
-        let targets = self.raster.targets.as_ref().expect("prepared");
+        state: &FrameState<'_>,
+    ) -> crate::gpu::GpuResult<(&Image, &Buffer)> {
+        self.record(rec, state, false)?;
+        let targets = self.targets.as_ref().expect("prepared");
         Ok((&targets.color, &targets.depth))
     }
 }
