@@ -110,9 +110,9 @@ struct Targets {
     previous_depth: Image,
     /// The resolved depth (view-axis metres, row-major), on the device.
     depth: Buffer,
-    /// Persistent read-back buffers of the host path (`render`, `render_layers`).
-    color_readback: Buffer,
-    depth_readback: Buffer,
+    /// Persistent read-back buffers (colour, depth) of the host path (`render`,
+    /// `render_layers`), made at its first frame: a frame that stays on the GPU needs none.
+    readback: Option<(Buffer, Buffer)>,
 }
 
 pub struct Rasterizer {
@@ -331,18 +331,7 @@ impl Rasterizer {
         let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
             depth: Buffer::new(ctx, "raster depth", pixels * 4, Residency::Device)?,
-            color_readback: Buffer::new(
-                ctx,
-                "raster colour read-back",
-                pixels * 16,
-                Residency::Readback,
-            )?,
-            depth_readback: Buffer::new(
-                ctx,
-                "raster depth read-back",
-                pixels * 4,
-                Residency::Readback,
-            )?,
+            readback: None,
             width,
             height,
             peel_framebuffer,
@@ -467,32 +456,46 @@ impl Rasterizer {
             eye_position_m,
             gap_d,
         )?;
+        let targets = self.targets.as_mut().expect("prepared");
+        if targets.readback.is_none() {
+            let pixels = u64::from(width) * u64::from(height);
+            targets.readback = Some((
+                Buffer::new(
+                    ctx,
+                    "raster colour read-back",
+                    pixels * 16,
+                    Residency::Readback,
+                )?,
+                Buffer::new(
+                    ctx,
+                    "raster depth read-back",
+                    pixels * 4,
+                    Residency::Readback,
+                )?,
+            ));
+        }
         let targets = self.targets.as_ref().expect("prepared");
+        let (color_readback, depth_readback) = targets.readback.as_ref().expect("made above");
         if let Some((previous, _)) = peel {
             targets.previous_depth.upload(ctx, previous)?;
         }
         let timings = ctx.submit(|rec| {
             self.record(rec, state, peel.is_some())?;
             rec.begin_pass("read back");
-            rec.copy_image_to_buffer(&targets.color, &targets.color_readback);
-            rec.copy_buffer(
-                &targets.depth,
-                &targets.depth_readback,
-                targets.depth.size_bytes(),
-            );
+            rec.copy_image_to_buffer(&targets.color, color_readback);
+            rec.copy_buffer(&targets.depth, depth_readback, targets.depth.size_bytes());
             Ok(())
         })?;
         let pixels = width as usize * height as usize;
-        let mapped = |b: &Buffer, bytes: usize| {
-            b.mapped_bytes()
+        fn mapped(b: &Buffer, bytes: usize) -> &[u8] {
+            &b.mapped_bytes()
                 .expect("read-back buffers are host-visible")[..bytes]
-                .to_vec()
-        };
+        }
         Ok(Frame {
             width,
             height,
-            color: bytemuck::pod_collect_to_vec(&mapped(&targets.color_readback, pixels * 16)),
-            depth_m: bytemuck::pod_collect_to_vec(&mapped(&targets.depth_readback, pixels * 4)),
+            color: bytemuck::pod_collect_to_vec(mapped(color_readback, pixels * 16)),
+            depth_m: bytemuck::pod_collect_to_vec(mapped(depth_readback, pixels * 4)),
             timings,
         })
     }
