@@ -291,9 +291,15 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let passes = report["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    // Steady-state frames keep the PSF texture (the eye's state does not change) and move
-    // their inputs in the same submission.
+    // Steady-state frames keep the PSF texture (the eye's state does not change), and draw
+    // the scene in splat's own submission: no frame is uploaded.
     assert!(!names.contains(&"psf texture"), "{names:?}");
+    assert!(!names.contains(&"upload"), "{names:?}");
+    assert!(
+        report["counters"]["upload_bytes"].as_u64().unwrap() < 4096,
+        "{}",
+        report["counters"]
+    );
     assert_eq!(
         report["counters"]["submissions"], 1,
         "{}",
@@ -305,7 +311,9 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
         report["counters"]
     );
     for want in [
-        "upload",
+        "raster",
+        "depth resolve",
+        "input",
         "fragments",
         "tile count",
         "prefix sum",

@@ -11,6 +11,8 @@ use ocular::render::blend::{BlendMode, BlendSettings};
 use ocular::render::splat::{
     FrameInput, MergeSettings, SplatOutput, SplatSettings, Splatter, ViewState,
 };
+use ocular::render::Rasterizer;
+use ocular::scene::{FrameState, Scene};
 
 struct Frame {
     color: Vec<[f32; 4]>,
@@ -215,5 +217,139 @@ fn early_exit_changes_the_image_by_less_than_epsilon() {
             }
         }
     }
+    common::finish(ctx);
+}
+
+const SCENE_W: u32 = 160;
+const SCENE_H: u32 = 90;
+
+/// Kernels for the primitives scene at 160×90: a synthetic eye focused at 1 D over 0–5 D.
+fn scene_grid() -> KernelGrid {
+    SyntheticEye::new(1.0, 3.0).grid(DioptreAxis::spanning(0.0, 5.0, 11), 20, &[3.0], SCENE_H)
+}
+
+fn scene_view() -> ViewState {
+    ViewState {
+        pupil_mm: 3.0,
+        focus_d: 1.0,
+    }
+}
+
+/// Splats a rasterised frame the old way: read back to the host, then uploaded.
+fn splat_through_host(
+    ctx: &ocular::gpu::Context,
+    raster: &mut Rasterizer,
+    splatter: &mut Splatter,
+    state: &FrameState<'_>,
+) -> SplatOutput {
+    let frame = raster.render(ctx, state, SCENE_W, SCENE_H).unwrap();
+    let input = FrameInput {
+        width: SCENE_W,
+        height: SCENE_H,
+        color: &frame.color,
+        depth_m: &frame.depth_m,
+        fov_y_deg: state.camera.fov_y_deg,
+        hidden_layers: &[],
+    };
+    splatter.render(&input, scene_view(), false).unwrap()
+}
+
+/// The rasterised frame stays on the GPU: drawn in splat's own submission and taken into its
+/// inputs there, it gives the same image as the frame read back and uploaded (the colour and
+/// depth are the same 32-bit floats either way, so the bar is exact equality), for two
+/// different views through one splatter (a stale input would fail the second).
+#[test]
+fn a_scene_frame_on_the_gpu_matches_the_host_round_trip() {
+    let ctx = common::gpu();
+    let scene = Scene::load("primitives").unwrap();
+    let first = scene.at_time(0.0);
+    let mut moved = scene.at_time(0.0);
+    moved.camera.position_m[0] += 0.3;
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    let mut on_gpu = Splatter::new(&ctx, scene_grid(), SplatSettings::default()).unwrap();
+    let mut via_host = Splatter::new(&ctx, scene_grid(), SplatSettings::default()).unwrap();
+    let mut previous: Option<Vec<[f32; 4]>> = None;
+    for state in [&first, &moved] {
+        let expected = splat_through_host(&ctx, &mut raster, &mut via_host, state);
+        let got = on_gpu
+            .render_recorded(
+                &mut raster.scene_frame(&ctx, state, (SCENE_W, SCENE_H)),
+                scene_view(),
+            )
+            .unwrap();
+        let worst = got
+            .color
+            .iter()
+            .zip(&expected.color)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+            .fold(0.0f32, f32::max);
+        eprintln!("largest difference GPU-resident vs host round trip: {worst:e}");
+        assert_eq!(got.color.len(), expected.color.len());
+        assert!(worst == 0.0, "largest difference {worst}");
+        if let Some(previous) = &previous {
+            assert_ne!(&got.color, previous, "the moved camera changed nothing");
+        }
+        previous = Some(got.color);
+    }
+    drop((on_gpu, via_host, raster));
+    common::finish(ctx);
+}
+
+/// A steady-state scene frame is one submission from the draw to the read-back, allocates
+/// nothing (rasteriser included: the device's own count), sends the device only its uniforms
+/// and radii, and reads back only the image and two list sizes. The host round trip, as a
+/// negative control, uploads the whole frame.
+#[test]
+fn a_steady_scene_frame_is_one_submission_and_uploads_no_pixels() {
+    const UPLOAD_BOUND: u64 = 4096;
+    let ctx = common::gpu();
+    let scene = Scene::load("primitives").unwrap();
+    let state = scene.at_time(0.0);
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    let mut splatter = Splatter::new(&ctx, scene_grid(), SplatSettings::default()).unwrap();
+    let mut frame = || {
+        splatter
+            .render_recorded(
+                &mut raster.scene_frame(&ctx, &state, (SCENE_W, SCENE_H)),
+                scene_view(),
+            )
+            .unwrap()
+    };
+    let first = frame();
+    eprintln!("first scene frame: {:?}", first.stats);
+    assert!(
+        first.stats.allocations > 0,
+        "the first frame made its targets"
+    );
+    for _ in 0..2 {
+        let allocations_before = ctx.allocations();
+        let next = frame();
+        eprintln!("steady scene frame: {:?}", next.stats);
+        assert_eq!(next.stats.submissions, 1);
+        assert_eq!(next.stats.allocations, 0);
+        assert_eq!(ctx.allocations(), allocations_before);
+        assert_eq!(next.stats.submission_objects, 0);
+        assert!(next.stats.upload_bytes <= UPLOAD_BOUND);
+        let image_bytes = u64::from(SCENE_W * SCENE_H) * 16;
+        assert_eq!(next.stats.readback_bytes, image_bytes + 8);
+        let passes: Vec<&str> = next
+            .timings
+            .passes
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect();
+        assert!(
+            passes.contains(&"raster") && passes.contains(&"convolve"),
+            "{passes:?}"
+        );
+        assert_eq!(next.color, first.color);
+    }
+    let mut via_host = Splatter::new(&ctx, scene_grid(), SplatSettings::default()).unwrap();
+    splat_through_host(&ctx, &mut raster, &mut via_host, &state);
+    let old = splat_through_host(&ctx, &mut raster, &mut via_host, &state);
+    eprintln!("steady host round-trip frame: {:?}", old.stats);
+    assert_eq!(old.stats.submissions, 1, "plus the raster's own submission");
+    assert!(old.stats.upload_bytes > UPLOAD_BOUND);
+    drop((splatter, via_host, raster));
     common::finish(ctx);
 }

@@ -235,6 +235,9 @@ pub(super) struct Input {
     pub(super) depth_source: Option<String>,
     pub(super) depth_report: Option<crate::inputs::DepthReport>,
     pub(super) warnings: Vec<String>,
+    /// A scene drawn as one layer: its rasteriser and scene, so that splat draws the frame
+    /// again inside its own submission instead of uploading these pixels.
+    pub(super) raster: Option<(Rasterizer, Scene)>,
 }
 
 fn load_input(
@@ -286,6 +289,7 @@ fn load_input(
                 .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
                 .collect(),
             warnings,
+            raster: None,
         });
     }
     let _ = cli;
@@ -341,16 +345,19 @@ fn load_input(
             crate::inputs::depth::near_clamp_warning(clamped)
         ));
     }
+    let (fov_y_deg, focus_m) = (state.camera.fov_y_deg, state.focus_m);
+    let (pupil_mm, luminance_cdm2) = (state.pupil_mm, state.luminance_cd_m2);
     Ok(Input {
         width,
         height,
         color: frame.color,
         depth_m,
-        fov_y_deg: state.camera.fov_y_deg,
-        focus_m: Some(state.focus_m),
-        pupil_mm: state.pupil_mm,
-        luminance_cdm2: state.luminance_cd_m2,
+        fov_y_deg,
+        focus_m: Some(focus_m),
+        pupil_mm,
+        luminance_cdm2,
         label: format!("scene {name}"),
+        raster: (k == 1).then_some((rasterizer, scene)),
         hidden,
         depth_source: None,
         depth_report: None,
@@ -531,7 +538,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         Some((args.age, args.accommodation_line)),
     )?;
     let ctx = Context::new(&cli.context_options())?;
-    let input = load_input(cli, args, &ctx, physiology.spectacle_magnification)?;
+    let mut input = load_input(cli, args, &ctx, physiology.spectacle_magnification)?;
     for w in &input.warnings {
         eprintln!("warning: {w}");
     }
@@ -626,7 +633,16 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             &[]
         },
     };
-    let frame = renderer.render(&frame_input, state, args.method)?;
+    let frame = match &mut input.raster {
+        // the frame stays on the GPU: drawn again in splat's submission, not uploaded
+        Some((rasterizer, scene)) if args.method == Method::Splat => {
+            let scene_state = scene.at_time(args.time);
+            let size = (input.width, input.height);
+            let mut recorded = rasterizer.scene_frame(&ctx, &scene_state, size);
+            renderer.render_recorded(&mut recorded, state)?
+        }
+        _ => renderer.render(&frame_input, state, args.method)?,
+    };
 
     let info = super::render_output::KernelInfo {
         from_cache,

@@ -14,16 +14,16 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 
 use super::raster::parse_frame_size;
+use super::video_frame::{self, compose};
 use super::video_manifest::{self as manifest, DigestLog, ExportConfig};
 use super::{sha256, Cli};
 use crate::eye::Eye;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
-use crate::optics::pupil::{watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
-use crate::render::frame::{dioptre_range, scene_needs, EyeState, FrameRenderer, Method};
-use crate::render::splat::{FrameInput, SplatSettings};
-use crate::render::{Frame, Rasterizer};
+use crate::render::frame::{dioptre_range, scene_needs, EyeState, FrameRenderer};
+use crate::render::splat::SplatSettings;
+use crate::render::Rasterizer;
 use crate::scene::{FrameState, Scene};
 use crate::{Error, Result};
 
@@ -207,28 +207,6 @@ impl Timeline {
             }
         }
     }
-}
-
-fn pupil_for(args: &VideoArgs, state: &FrameState<'_>, frame: &Frame, fov_y_deg: f64) -> f64 {
-    if let Some(p) = args.pupil_mm.or(state.pupil_mm) {
-        return p;
-    }
-    let luminance = state.luminance_cd_m2.unwrap_or_else(|| {
-        let sum: f64 = frame
-            .color
-            .iter()
-            .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
-            .sum();
-        sum / frame.color.len().max(1) as f64
-    });
-    let aspect = f64::from(frame.width) / f64::from(frame.height);
-    watson_yellott_mm(
-        luminance,
-        fov_y_deg * fov_y_deg * aspect,
-        args.age,
-        Viewing::OneEye,
-    )
-    .clamp(1.5, 8.0)
 }
 
 /// Frames sampled for planning the kernels: evenly spread, first and last included.
@@ -502,7 +480,13 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             ));
             states.push(EyeState {
                 focus_d: timeline.focus_d(i, &state),
-                pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
+                pupil_mm: video_frame::pupil_for(
+                    args,
+                    &state,
+                    Some(&frame),
+                    (width, height),
+                    fov_y_deg,
+                ),
             });
         }
     }
@@ -527,37 +511,19 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         .iter()
         .map(|(_, e)| super::correction::spectacle_magnification(e))
         .collect::<Result<Vec<_>>>()?;
-    const IDENTITY: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
     let bar = progress_bar(todo.len() as u64);
     let started = Instant::now();
     for &i in &todo {
         let state = timeline.state(i);
-        rasterizer.set_view_magnification(IDENTITY);
-        let frame = rasterizer.render(&ctx, &state, width, height)?;
-        let eye_state = EyeState {
-            focus_d: timeline.focus_d(i, &state),
-            pupil_mm: pupil_for(args, &state, &frame, fov_y_deg),
-        };
-        let mut panels = Vec::new();
-        for (renderer, magnification) in renderers.iter_mut().zip(&magnifications) {
-            let through = match magnification {
-                Some(m) => {
-                    rasterizer.set_view_magnification(*m);
-                    Some(rasterizer.render(&ctx, &state, width, height)?)
-                }
-                None => None,
-            };
-            let seen = through.as_ref().unwrap_or(&frame);
-            let input = FrameInput {
-                width,
-                height,
-                color: &seen.color,
-                depth_m: &seen.depth_m,
-                fov_y_deg: state.camera.fov_y_deg,
-                hidden_layers: &[],
-            };
-            panels.push(renderer.render(&input, eye_state, Method::Splat)?.color);
-        }
+        let panels = video_frame::render_panels(
+            &ctx,
+            &mut rasterizer,
+            &state,
+            (width, height),
+            (args, timeline.focus_d(i, &state), fov_y_deg),
+            &mut renderers,
+            &magnifications,
+        )?;
         let labels: Vec<&str> = eyes.iter().map(|(name, _)| name.as_str()).collect();
         let image = compose(
             width,
@@ -700,32 +666,6 @@ fn remove_stale_temporaries(dir: &Path) {
             let _ = std::fs::remove_file(entry.path());
         }
     }
-}
-
-/// Panels side by side; labels drawn in the top-left corner of each panel.
-fn compose(
-    width: u32,
-    height: u32,
-    panels: &[Vec<[f32; 4]>],
-    labels: Option<&[&str]>,
-) -> ImageRgba {
-    let n = panels.len() as u32;
-    let mut pixels = vec![[0.0f32, 0.0, 0.0, 1.0]; (width * n * height) as usize];
-    for (k, panel) in panels.iter().enumerate() {
-        for y in 0..height {
-            for x in 0..width {
-                pixels[(y * width * n + k as u32 * width + x) as usize] =
-                    panel[(y * width + x) as usize];
-            }
-        }
-    }
-    let mut image = ImageRgba::new(width * n, height, pixels);
-    if let Some(labels) = labels {
-        for (k, label) in labels.iter().enumerate() {
-            crate::psf::preview::draw_label(&mut image, k as u32 * width + 6, 6, label);
-        }
-    }
-    image
 }
 
 fn encode_mp4(dir: &Path, fps: f64, mp4: &Path) -> Result<()> {

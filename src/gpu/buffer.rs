@@ -41,6 +41,16 @@ pub(crate) fn out_of_memory(what: &str, bytes: u64) -> GpuError {
     }
 }
 
+impl Context {
+    /// Buffers and images allocated on this device so far, by anyone: a steady-state frame
+    /// leaves it unchanged.
+    pub fn allocations(&self) -> u64 {
+        self.shared
+            .allocations
+            .load(std::sync::atomic::Ordering::Relaxed)
+    }
+}
+
 impl Buffer {
     /// A buffer of `size_bytes` (at least 16: Vulkan has no empty buffers). Device buffers can
     /// be storage, copy source and copy destination; host buffers are transfer buffers.
@@ -75,6 +85,9 @@ impl Buffer {
         })?;
         // SAFETY: `raw` was just created on this device.
         let requirements = unsafe { shared.device.get_buffer_memory_requirements(raw) };
+        shared
+            .allocations
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let allocation = shared.allocator().allocate(&AllocationCreateDesc {
             name,
             requirements,

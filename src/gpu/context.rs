@@ -195,6 +195,8 @@ pub(crate) struct DeviceShared {
     pub(crate) submit_slots: Mutex<Vec<super::submit_slot::SubmitSlot>>,
     /// Vulkan objects created for submissions since the device was opened.
     pub(crate) objects_created: std::sync::atomic::AtomicU64,
+    /// Buffers and images given memory since the device was opened (`Context::allocations`).
+    pub(crate) allocations: std::sync::atomic::AtomicU64,
     pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
     pub(crate) properties: vk::PhysicalDeviceProperties,
     pub(crate) timestamp_valid_bits: u32,
@@ -605,6 +607,7 @@ impl Context {
                 command_pool: Mutex::new(pool),
                 submit_slots: Mutex::new(Vec::new()),
                 objects_created: std::sync::atomic::AtomicU64::new(0),
+                allocations: std::sync::atomic::AtomicU64::new(0),
                 allocator: ManuallyDrop::new(Mutex::new(allocator)),
                 properties,
                 timestamp_valid_bits: families[queue_family as usize].timestamp_valid_bits,

@@ -251,6 +251,9 @@ impl Image {
         })?;
         // SAFETY: `raw` was just created on this device.
         let requirements = unsafe { shared.device.get_image_memory_requirements(raw) };
+        shared
+            .allocations
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let allocation = shared.allocator().allocate(&AllocationCreateDesc {
             name,
             requirements,

@@ -15,7 +15,9 @@ use crate::psf::field_plan::{plan_for_frame, FieldPlan};
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::KernelGrid;
 use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
-use crate::render::splat::{FrameInput, SplatSettings, SplatStats, Splatter, ViewState};
+use crate::render::splat::{
+    FrameInput, RecordedInput, SplatSettings, SplatStats, Splatter, ViewState,
+};
 use crate::render::{reference, slices};
 use crate::{Error, Result};
 
@@ -309,6 +311,46 @@ impl FrameRenderer {
         &self.kernels
     }
 
+    fn splatter(&mut self) -> Result<&mut Splatter> {
+        if self.splatter.is_none() {
+            self.splatter = Some(match &self.kernels.field {
+                None => Splatter::new(&self.ctx, self.kernels.grid.clone(), self.splat_settings)?,
+                Some(f) => Splatter::new_field(&self.ctx, f.kernels.clone(), self.splat_settings)?,
+            });
+        }
+        Ok(self.splatter.as_mut().expect("just created"))
+    }
+
+    fn check_height(&self, height: u32) -> Result<()> {
+        let screen = self.kernels.plan.screen;
+        if height != screen.height_px {
+            return Err(Error::input(format!(
+                "frame height {height} differs from the {} px the kernels were projected for",
+                screen.height_px
+            )));
+        }
+        Ok(())
+    }
+
+    /// Splats a frame the GPU makes within splat's own submission (a rasterised scene,
+    /// [`crate::render::Rasterizer::scene_frame`]): its pixels never cross to the host.
+    pub fn render_recorded(
+        &mut self,
+        frame: &mut dyn RecordedInput,
+        state: EyeState,
+    ) -> Result<RenderedFrame> {
+        self.check_height(frame.size().1)?;
+        let started = Instant::now();
+        let out = self.splatter()?.render_recorded(frame, view_state(state))?;
+        Ok(RenderedFrame {
+            color: out.color,
+            method: Method::Splat,
+            seconds: started.elapsed().as_secs_f64(),
+            timings: Some(out.timings),
+            stats: Some(out.stats),
+        })
+    }
+
     pub fn render(
         &mut self,
         input: &FrameInput<'_>,
@@ -316,12 +358,7 @@ impl FrameRenderer {
         method: Method,
     ) -> Result<RenderedFrame> {
         let screen = self.kernels.plan.screen;
-        if input.height != screen.height_px {
-            return Err(Error::input(format!(
-                "frame height {} differs from the {} px the kernels were projected for",
-                input.height, screen.height_px
-            )));
-        }
+        self.check_height(input.height)?;
         let started = Instant::now();
         match method {
             Method::Views => Err(Error::input(
@@ -329,27 +366,7 @@ impl FrameRenderer {
                  scene, not a colour + depth frame",
             )),
             Method::Splat => {
-                if self.splatter.is_none() {
-                    self.splatter = Some(match &self.kernels.field {
-                        None => Splatter::new(
-                            &self.ctx,
-                            self.kernels.grid.clone(),
-                            self.splat_settings,
-                        )?,
-                        Some(f) => {
-                            Splatter::new_field(&self.ctx, f.kernels.clone(), self.splat_settings)?
-                        }
-                    });
-                }
-                let splatter = self.splatter.as_mut().expect("just created");
-                let out = splatter.render(
-                    input,
-                    ViewState {
-                        pupil_mm: state.pupil_mm,
-                        focus_d: state.focus_d,
-                    },
-                    false,
-                )?;
+                let out = self.splatter()?.render(input, view_state(state), false)?;
                 Ok(RenderedFrame {
                     color: out.color,
                     method,
@@ -392,5 +409,12 @@ impl FrameRenderer {
                 })
             }
         }
+    }
+}
+
+fn view_state(state: EyeState) -> ViewState {
+    ViewState {
+        pupil_mm: state.pupil_mm,
+        focus_d: state.focus_d,
     }
 }

@@ -7,6 +7,7 @@ pub mod frame;
 pub mod projection;
 pub mod raster;
 pub mod reference;
+pub mod scene_frame;
 pub mod slices;
 pub mod splat;
 pub mod views;

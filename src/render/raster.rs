@@ -7,11 +7,15 @@
 //! across an edge. Pixels no object covers get the background colour and depth `far_m`.
 //! Colour is 32-bit float throughout: values are cd/m², and lamps, the sun and specular
 //! emitters exceed half float's 65504 (a half-float target clipped them silently).
+//!
+//! A frame is either read back (`render`, `render_layers`: inputs for the host) or recorded
+//! into another submission and left on the GPU (`scene_frame`, splat's input): both go
+//! through the same `prepare` (uniforms through a persistent mapping) and `record`.
 
 use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
-    GraphicsPipeline, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings, VertexAttribute,
-    VertexFormat,
+    GraphicsPipeline, Image, ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings,
+    VertexAttribute, VertexFormat,
 };
 use crate::image_io::{ImageGray, ImageRgba};
 use crate::scene::{FrameState, Light, Vertex, MAX_LIGHTS};
@@ -22,6 +26,10 @@ pub const MSAA_SAMPLES: u32 = 4;
 
 /// Depth layers a scene is peeled to for splat unless told otherwise (README: measured).
 pub const DEFAULT_LAYERS: u32 = 1;
+
+/// Bytes of uniforms a frame sends the device (its only host→device data once the scene is
+/// resident).
+pub const FRAME_UNIFORM_BYTES: u64 = std::mem::size_of::<FrameUniform>() as u64;
 
 /// A rendered frame on the CPU: row-major, top row first.
 #[derive(Clone, Debug)]
@@ -100,6 +108,11 @@ struct Targets {
     /// The same targets for the peeling pipeline, and the previous layer's depth it reads.
     peel_framebuffer: Framebuffer,
     previous_depth: Image,
+    /// The resolved depth (view-axis metres, row-major), on the device.
+    depth: Buffer,
+    /// Persistent read-back buffers (colour, depth) of the host path (`render`,
+    /// `render_layers`), made at its first frame: a frame that stays on the GPU needs none.
+    readback: Option<(Buffer, Buffer)>,
 }
 
 pub struct Rasterizer {
@@ -111,6 +124,8 @@ pub struct Rasterizer {
     white: Image,
     scene: Option<GpuScene>,
     targets: Option<Targets>,
+    /// The frame's uniforms, written through the mapping before each frame's submission.
+    uniforms: Buffer,
     /// How directions in front of the eye appear (view-space x, y: +x right, +y up): the
     /// angular magnification of a spectacle lens, identity without one.
     view_magnification: [[f64; 2]; 2],
@@ -142,6 +157,12 @@ impl Rasterizer {
             white,
             scene: None,
             targets: None,
+            uniforms: Buffer::new(
+                ctx,
+                "raster frame uniforms",
+                std::mem::size_of::<FrameUniform>() as u64,
+                Residency::Upload,
+            )?,
             view_magnification: [[1.0, 0.0], [0.0, 1.0]],
         })
     }
@@ -275,13 +296,17 @@ impl Rasterizer {
             TexelFormat::D32Float,
             attachment(true, false, MSAA_SAMPLES),
         )?;
+        // storage: splat's input pass reads it where the frame stays on the GPU
         let color = Image::new_2d(
             ctx,
             "raster colour",
             width,
             height,
             TexelFormat::Rgba32Float,
-            attachment(false, false, 1),
+            ImageUsage {
+                storage: true,
+                ..attachment(false, false, 1)
+            },
         )?;
         let framebuffer = self.pipeline.framebuffer(
             ctx,
@@ -303,7 +328,10 @@ impl Rasterizer {
             TexelFormat::R32Float,
             ImageUsage::SAMPLED,
         )?;
+        let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
+            depth: Buffer::new(ctx, "raster depth", pixels * 4, Residency::Device)?,
+            readback: None,
             width,
             height,
             peel_framebuffer,
@@ -419,6 +447,70 @@ impl Rasterizer {
         eye_position_m: [f64; 3],
         peel: Option<(&[f32], f32)>,
     ) -> Result<Frame> {
+        let gap_d = peel.map(|(_, gap)| gap);
+        self.prepare(
+            ctx,
+            state,
+            (width, height),
+            view_proj,
+            eye_position_m,
+            gap_d,
+        )?;
+        let targets = self.targets.as_mut().expect("prepared");
+        if targets.readback.is_none() {
+            let pixels = u64::from(width) * u64::from(height);
+            targets.readback = Some((
+                Buffer::new(
+                    ctx,
+                    "raster colour read-back",
+                    pixels * 16,
+                    Residency::Readback,
+                )?,
+                Buffer::new(
+                    ctx,
+                    "raster depth read-back",
+                    pixels * 4,
+                    Residency::Readback,
+                )?,
+            ));
+        }
+        let targets = self.targets.as_ref().expect("prepared");
+        let (color_readback, depth_readback) = targets.readback.as_ref().expect("made above");
+        if let Some((previous, _)) = peel {
+            targets.previous_depth.upload(ctx, previous)?;
+        }
+        let timings = ctx.submit(|rec| {
+            self.record(rec, state, peel.is_some())?;
+            rec.begin_pass("read back");
+            rec.copy_image_to_buffer(&targets.color, color_readback);
+            rec.copy_buffer(&targets.depth, depth_readback, targets.depth.size_bytes());
+            Ok(())
+        })?;
+        let pixels = width as usize * height as usize;
+        fn mapped(b: &Buffer, bytes: usize) -> &[u8] {
+            &b.mapped_bytes()
+                .expect("read-back buffers are host-visible")[..bytes]
+        }
+        Ok(Frame {
+            width,
+            height,
+            color: bytemuck::pod_collect_to_vec(mapped(color_readback, pixels * 16)),
+            depth_m: bytemuck::pod_collect_to_vec(mapped(depth_readback, pixels * 4)),
+            timings,
+        })
+    }
+
+    /// Everything a frame needs before its commands are recorded: the scene on the GPU,
+    /// targets of this size and the frame's uniforms (written through their mapping).
+    fn prepare(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        (width, height): (u32, u32),
+        view_proj: glam::DMat4,
+        eye_position_m: [f64; 3],
+        peel_gap_d: Option<f32>,
+    ) -> Result<()> {
         if width == 0 || height == 0 {
             return Err(Error::input(format!(
                 "frame size {width}×{height} has no pixels"
@@ -426,13 +518,9 @@ impl Rasterizer {
         }
         self.upload_scene(ctx, state)?;
         self.ensure_targets(ctx, width, height)?;
-        let scene = state.scene;
-        let camera = &state.camera;
-
-        let view = camera.view_matrix();
         let mut uniform = FrameUniform {
             view_proj: view_proj.as_mat4().to_cols_array_2d(),
-            view: view.as_mat4().to_cols_array_2d(),
+            view: state.camera.view_matrix().as_mat4().to_cols_array_2d(),
             camera_position: [
                 eye_position_m[0] as f32,
                 eye_position_m[1] as f32,
@@ -447,7 +535,7 @@ impl Rasterizer {
             }; MAX_LIGHTS],
         };
         let mut count = 0usize;
-        for light in &scene.lights {
+        for light in &state.scene.lights {
             match *light {
                 Light::Ambient { rgb_lux } => {
                     for (sum, add) in uniform.ambient.iter_mut().zip(rgb_lux) {
@@ -471,128 +559,127 @@ impl Rasterizer {
             }
         }
         uniform.counts[0] = count as u32;
-        let bg = scene.background_rgb;
         // the peeling shader reads its gap from the otherwise unused ambient.w
-        if let Some((_, gap_d)) = peel {
+        if let Some(gap_d) = peel_gap_d {
             uniform.ambient[3] = gap_d;
         }
-        let mut uniform_buffer = Buffer::new(
-            ctx,
-            "raster frame uniforms",
-            std::mem::size_of::<FrameUniform>() as u64,
-            Residency::Upload,
-        )?;
-        uniform_buffer
+        self.uniforms
             .mapped_bytes_mut()
             .expect("upload buffers are host-visible")[..std::mem::size_of::<FrameUniform>()]
             .copy_from_slice(bytemuck::bytes_of(&uniform));
+        Ok(())
+    }
 
-        let pixels = width as usize * height as usize;
-        let depth_readback = Buffer::new(
-            ctx,
-            "raster depth",
-            (pixels * 4) as u64,
-            Residency::Readback,
-        )?;
-        let color_readback = Buffer::new(
-            ctx,
-            "raster colour",
-            (pixels * 16) as u64,
-            Residency::Readback,
-        )?;
-
-        let gpu_scene = self.scene.as_ref().expect("uploaded above");
-        let targets = self.targets.as_ref().expect("created above");
-        if let Some((previous, _)) = peel {
-            targets.previous_depth.upload(ctx, previous)?;
-        }
-        let (pipeline, framebuffer, clear) = match peel {
-            None => (
+    /// Records the prepared frame's draw and depth resolve: colour in `targets.color`, depth
+    /// in `targets.depth`.
+    fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        state: &FrameState<'_>,
+        peel: bool,
+    ) -> crate::gpu::GpuResult<()> {
+        let gpu_scene = self.scene.as_ref().expect("prepared");
+        let targets = self.targets.as_ref().expect("prepared");
+        let (width, height) = (targets.width, targets.height);
+        let bg = state.scene.background_rgb;
+        let (pipeline, framebuffer, clear) = if peel {
+            (&self.peel, &targets.peel_framebuffer, [0.0; 4])
+        } else {
+            (
                 &self.pipeline,
                 &targets.framebuffer,
                 [bg[0], bg[1], bg[2], 1.0],
-            ),
-            Some(_) => (&self.peel, &targets.peel_framebuffer, [0.0; 4]),
+            )
         };
-        let far = camera.far_m as f32;
-        let materials = &scene.geometry.materials;
-        let timings = ctx.submit(|rec| {
-            rec.begin_pass("raster");
-            rec.begin_render_pass(pipeline, framebuffer, &[clear, [far, 0.0, 0.0, 0.0]], 0.0)?;
-            for batch in &scene.geometry.batches {
-                let material = &materials[batch.material];
-                let texture = material
-                    .texture
-                    .and_then(|t| gpu_scene.textures.get(t))
-                    .unwrap_or(&self.white);
-                let push = MaterialPush {
-                    albedo: [
-                        material.albedo[0],
-                        material.albedo[1],
-                        material.albedo[2],
-                        if material.texture.is_some() { 1.0 } else { 0.0 },
-                    ],
-                    emission: [
-                        material.emission[0],
-                        material.emission[1],
-                        material.emission[2],
-                        0.0,
-                    ],
-                };
-                let previous = Binding::Sampled(&targets.previous_depth, &self.point_sampler);
-                let bindings = [
-                    Binding::Buffer(&uniform_buffer),
-                    Binding::Sampled(texture, &self.texture_sampler),
-                    previous,
-                ];
-                rec.draw_indexed(
-                    pipeline,
-                    &bindings[..if peel.is_some() { 3 } else { 2 }],
-                    &push,
-                    &gpu_scene.vertices,
-                    &gpu_scene.indices,
-                    batch.first_index,
-                    batch.index_count,
-                )?;
-            }
-            rec.end_render_pass()?;
-            rec.begin_pass("depth resolve");
-            rec.dispatch(
-                &self.resolve,
-                &[
-                    Binding::Sampled(&targets.view_depth_ms, &self.point_sampler),
-                    Binding::Buffer(&depth_readback),
+        let far = state.camera.far_m as f32;
+        let materials = &state.scene.geometry.materials;
+        rec.begin_pass("raster");
+        rec.begin_render_pass(pipeline, framebuffer, &[clear, [far, 0.0, 0.0, 0.0]], 0.0)?;
+        for batch in &state.scene.geometry.batches {
+            let material = &materials[batch.material];
+            let texture = material
+                .texture
+                .and_then(|t| gpu_scene.textures.get(t))
+                .unwrap_or(&self.white);
+            let push = MaterialPush {
+                albedo: [
+                    material.albedo[0],
+                    material.albedo[1],
+                    material.albedo[2],
+                    if material.texture.is_some() { 1.0 } else { 0.0 },
                 ],
-                &ResolvePush {
-                    width,
-                    height,
-                    samples: MSAA_SAMPLES,
-                },
-                [width.div_ceil(8), height.div_ceil(8), 1],
+                emission: [
+                    material.emission[0],
+                    material.emission[1],
+                    material.emission[2],
+                    0.0,
+                ],
+            };
+            let bindings = [
+                Binding::Buffer(&self.uniforms),
+                Binding::Sampled(texture, &self.texture_sampler),
+                Binding::Sampled(&targets.previous_depth, &self.point_sampler),
+            ];
+            rec.draw_indexed(
+                pipeline,
+                &bindings[..if peel { 3 } else { 2 }],
+                &push,
+                &gpu_scene.vertices,
+                &gpu_scene.indices,
+                batch.first_index,
+                batch.index_count,
             )?;
-            rec.begin_pass("read back");
-            rec.copy_image_to_buffer(&targets.color, &color_readback);
-            Ok(())
-        })?;
-        // Keep the MSAA targets referenced so that nothing reorders their lifetime.
+        }
+        rec.end_render_pass()?;
+        rec.begin_pass("depth resolve");
+        rec.dispatch(
+            &self.resolve,
+            &[
+                Binding::Sampled(&targets.view_depth_ms, &self.point_sampler),
+                Binding::Buffer(&targets.depth),
+            ],
+            &ResolvePush {
+                width,
+                height,
+                samples: MSAA_SAMPLES,
+            },
+            [width.div_ceil(8), height.div_ceil(8), 1],
+        )?;
+        // The MSAA targets live as long as the framebuffers that use them.
         let _ = (&targets.color_ms, &targets.depth_ms);
+        Ok(())
+    }
 
-        let color: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(
-            &color_readback
-                .mapped_bytes()
-                .expect("read-back buffers are host-visible")[..pixels * 16],
-        );
-        let depth_m: Vec<f32> = bytemuck::pod_collect_to_vec(
-            &depth_readback
-                .mapped_bytes()
-                .expect("read-back buffers are host-visible")[..pixels * 4],
-        );
-        Ok(Frame {
-            width,
-            height,
-            color,
-            depth_m,
-            timings,
-        })
+    /// Prepares `state`'s frame, seen by its own camera at `width`×`height`, for recording
+    /// into another submission; returns the bytes it wrote for the device.
+    pub(crate) fn prepare_camera_frame(
+        &mut self,
+        ctx: &Context,
+        state: &FrameState<'_>,
+        (width, height): (u32, u32),
+    ) -> Result<u64> {
+        let camera = &state.camera;
+        let aspect = f64::from(width) / f64::from(height);
+        let view_proj = self.view_projection(camera, aspect);
+        self.prepare(
+            ctx,
+            state,
+            (width, height),
+            view_proj,
+            camera.position_m,
+            None,
+        )?;
+        Ok(FRAME_UNIFORM_BYTES)
+    }
+
+    /// Records the prepared frame; returns where it leaves the colour and the depth.
+    pub(crate) fn record_frame(
+        &self,
+        rec: &mut Recorder<'_>,
+        state: &FrameState<'_>,
+    ) -> crate::gpu::GpuResult<(&Image, &Buffer)> {
+        self.record(rec, state, false)?;
+        let targets = self.targets.as_ref().expect("prepared");
+        Ok((&targets.color, &targets.depth))
     }
 }

@@ -8,9 +8,11 @@
 //!
 //! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`.
 
+mod bands;
 mod convolve;
 mod field;
 mod fragments;
+mod input;
 mod merge;
 mod prefix_sum;
 mod psf_texture;
@@ -24,6 +26,8 @@ use crate::gpu::{
 use crate::psf::kernels::KernelGrid;
 use crate::render::blend::{BlendMode, BlendSettings};
 
+use bands::plan_bands;
+pub use input::RecordedInput;
 pub use psf_texture::PsfTextureFormat;
 
 /// Mirrors `struct Fragment` in glsl/common/splat.glsl (std430, 48 bytes).
@@ -265,9 +269,9 @@ struct FrameResources {
     cursors: Buffer,
     offsets: Buffer,
     block_sums: Buffer,
-    /// Persistent, mapped transfer buffers: inputs in, the image and the list sizes out.
-    staging_color: Buffer,
-    staging_depth: Buffer,
+    /// Persistent, mapped transfer buffers: host inputs in (made at the first host frame),
+    /// the image and the list sizes out.
+    staging: Option<input::Staging>,
     readback_color: Buffer,
     /// counts (tiles + 1, the last = live fragments), then offsets (tiles + 1, the last = total).
     readback_lists: Buffer,
@@ -293,12 +297,11 @@ pub struct Splatter {
     texture_blend: Option<crate::psf::kernels::GridBlend>,
     /// Lists of the last frame: total entries and bands (decides the one-submission path).
     last_lists: Option<(u64, usize)>,
-    /// GPU allocations made so far (buffers and images of frame-size resources and lists).
-    allocations: u32,
     /// Per set, the core radius of every object's kernels (see `KernelSet::core_radii_px`).
     core_radii: Vec<Vec<[f32; 3]>>,
     frame: Option<FrameResources>,
     entries: Option<Buffer>,
+    input: input::InputPass,
     psf_texture: psf_texture::PsfTexturePass,
     fragments_pass: fragments::FragmentsPass,
     merge: merge::MergePass,
@@ -424,10 +427,10 @@ impl Splatter {
             )?,
             texture_blend: None,
             last_lists: None,
-            allocations: 0,
             core_radii,
             frame: None,
             entries: None,
+            input: input::InputPass::new(ctx)?,
             psf_texture: psf_texture::PsfTexturePass::new(ctx)?,
             fragments_pass: fragments::FragmentsPass::new(ctx)?,
             merge: merge::MergePass::new(ctx)?,
@@ -533,13 +536,7 @@ impl Splatter {
                 tiles.div_ceil(1024) * 4,
                 Residency::Device,
             )?,
-            staging_color: Buffer::new(
-                ctx,
-                "input colour staging",
-                pixels * 16,
-                Residency::Upload,
-            )?,
-            staging_depth: Buffer::new(ctx, "input depth staging", pixels * 4, Residency::Upload)?,
+            staging: None,
             readback_color: Buffer::new(
                 ctx,
                 "output read-back",
@@ -553,7 +550,6 @@ impl Splatter {
                 Residency::Readback,
             )?,
         });
-        self.allocations += 13;
         self.texture_blend = None;
         self.last_lists = None;
         Ok(())
@@ -601,39 +597,39 @@ impl Splatter {
         view: ViewState,
         keep_intermediates: bool,
     ) -> crate::Result<SplatOutput> {
-        let (w, h) = (input.width, input.height);
+        self.render_from(input::Source::Host(input), view, keep_intermediates)
+    }
+
+    /// Renders a frame the GPU makes within splat's own submission (a rasterised scene): in
+    /// steady state the whole frame is one submission, and only the output image and two list
+    /// sizes cross to the host.
+    pub fn render_recorded(
+        &mut self,
+        frame: &mut dyn RecordedInput,
+        view: ViewState,
+    ) -> crate::Result<SplatOutput> {
+        self.render_from(input::Source::Gpu(frame), view, false)
+    }
+
+    fn render_from(
+        &mut self,
+        mut source: input::Source<'_, '_>,
+        view: ViewState,
+        keep_intermediates: bool,
+    ) -> crate::Result<SplatOutput> {
+        let shape = source.shape()?;
+        let (w, h) = (shape.width, shape.height);
         let pixels = w as usize * h as usize;
-        if w == 0 || h == 0 || input.color.len() != pixels || input.depth_m.len() != pixels {
-            return Err(crate::Error::input(format!(
-                "frame of {w}×{h} needs {pixels} colour and depth values (got {} and {})",
-                input.color.len(),
-                input.depth_m.len()
-            )));
-        }
-        crate::limits::FOV_Y_DEG
-            .check("vertical field of view", input.fov_y_deg)
-            .map_err(crate::Error::input)?;
         if !(view.pupil_mm.is_finite() && view.pupil_mm > 0.0 && view.focus_d.is_finite()) {
             return Err(crate::Error::input(format!(
                 "pupil {} mm / focus {} D must be finite, pupil positive",
                 view.pupil_mm, view.focus_d
             )));
         }
-        let allocations_before = self.allocations;
-        let objects_before = self.ctx.submission_objects_created();
-        for (k, layer) in input.hidden_layers.iter().enumerate() {
-            if layer.color.len() != pixels || layer.depth_m.len() != pixels {
-                return Err(crate::Error::input(format!(
-                    "hidden layer {} of a {w}×{h} frame needs {pixels} colour and depth values \
-                     (got {} and {})",
-                    k + 1,
-                    layer.color.len(),
-                    layer.depth_m.len()
-                )));
-            }
-        }
-        self.ensure_frame(w, h, 1 + input.hidden_layers.len() as u32)?;
         let ctx = self.ctx.clone();
+        let allocations_before = ctx.allocations();
+        let objects_before = ctx.submission_objects_created();
+        self.ensure_frame(w, h, shape.layers)?;
         let blend = self.grid.blend(view.pupil_mm, view.focus_d);
         // xyz: natural radius per channel; w: the smallest core radius over the channels,
         // which decides merging.
@@ -645,25 +641,20 @@ impl Splatter {
             .zip(&core)
             .map(|(r, k)| [r[0], r[1], r[2], k[0].min(k[1]).min(k[2])])
             .collect();
-        {
-            // Inputs go through persistent mapped buffers: no allocation per frame.
-            let frame = self.frame.as_mut().expect("ensured above");
-            write_mapped(&mut frame.staging_color, input.color);
-            write_mapped(&mut frame.staging_depth, input.depth_m);
-            for (k, layer) in input.hidden_layers.iter().enumerate() {
-                write_mapped_at(&mut frame.staging_color, (k + 1) * pixels, layer.color);
-                write_mapped_at(&mut frame.staging_depth, (k + 1) * pixels, layer.depth_m);
-            }
-            write_mapped(&mut self.radii_staging, &radii);
-        }
+        // Inputs and radii go through persistent mapped buffers: no allocation per frame.
+        let input_bytes = source.stage(&ctx, self.frame.as_mut().expect("ensured above"))?;
+        input::write_mapped_at(&mut self.radii_staging, 0, &radii);
         let table = self.field_table.contents(self.nodes(), &blend);
-        write_mapped(&mut self.field_table.staging, &table);
-        let upload_bytes = (pixels * 20 * (1 + input.hidden_layers.len())
-            + radii.len() * 16
-            + table.len() * 16) as u64;
+        input::write_mapped_at(&mut self.field_table.staging, 0, &table);
+        let upload_bytes = input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16;
+        let projection = crate::render::projection::Projection {
+            width: w,
+            height: h,
+            fov_y_deg: shape.fov_y_deg,
+        };
         let frame = self.frame.as_ref().expect("ensured above");
         let mut params = self.params(frame);
-        params.focal_px = input.projection().focal_px() as f32;
+        params.focal_px = projection.focal_px() as f32;
         let tiles = frame.tiles_x * frame.tiles_y;
         let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
         let output_bytes = pixels as u64 * 16;
@@ -682,7 +673,7 @@ impl Splatter {
             let mut p = params;
             p.entry_capacity = entries_in(entries);
             let timings = ctx.submit(|rec| {
-                self.record_front(rec, frame, &p, &blend, rebuild_texture)?;
+                self.record_front(rec, &source, frame, &p, &blend, rebuild_texture)?;
                 rec.copy_buffer_region(
                     &frame.counts,
                     u64::from(tiles) * 4,
@@ -716,7 +707,7 @@ impl Splatter {
                     max_entries_per_tile: 0,
                     bands: 1,
                     submissions,
-                    allocations: self.allocations - allocations_before,
+                    allocations: (ctx.allocations() - allocations_before) as u32,
                     submission_objects: ctx.submission_objects_created() - objects_before,
                     barriers: sync.0,
                     commands: sync.1,
@@ -734,7 +725,7 @@ impl Splatter {
 
         // Planning frame: everything up to the exact list sizes, read back to plan bands.
         let mut timings = ctx.submit(|rec| {
-            self.record_front(rec, frame, &params, &blend, true)?;
+            self.record_front(rec, &source, frame, &params, &blend, true)?;
             rec.end_pass();
             rec.copy_buffer_region(
                 &frame.counts,
@@ -802,7 +793,7 @@ impl Splatter {
             max_entries_per_tile: counts.iter().copied().max().unwrap_or(0).into(),
             bands: bands.len() as u32,
             submissions,
-            allocations: self.allocations - allocations_before,
+            allocations: (ctx.allocations() - allocations_before) as u32,
             submission_objects: ctx.submission_objects_created() - objects_before,
             barriers: sync.0,
             commands: sync.1,
@@ -835,14 +826,13 @@ impl Splatter {
     fn record_front(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
+        source: &input::Source<'_, '_>,
         frame: &FrameResources,
         params: &FrameParams,
         blend: &crate::psf::kernels::GridBlend,
         rebuild_texture: bool,
     ) -> crate::gpu::GpuResult<()> {
-        rec.begin_pass("upload");
-        rec.copy_buffer_to_image(&frame.staging_color, &frame.color_in);
-        rec.copy_buffer_to_image(&frame.staging_depth, &frame.depth_in);
+        source.record(rec, &self.input, frame)?;
         rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
         rec.copy_buffer(
             &self.field_table.staging,
@@ -956,7 +946,6 @@ impl Splatter {
             .min(self.list_capacity_entries() * ENTRY_BYTES)
             .max(needed);
         self.entries = None;
-        self.allocations += 1;
         self.entries = Some(Buffer::new(
             &self.ctx,
             "tile lists",
@@ -967,80 +956,9 @@ impl Splatter {
     }
 }
 
-/// A range of whole tile rows processed together, and where its entries start in the global
-/// (prefix-sum) numbering.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Band {
-    pub first_tile: u32,
-    pub end_tile: u32,
-    pub first_entry: u32,
-    pub entries: u64,
-}
-
-/// Splits the screen into bands of whole tile rows whose lists fit `capacity` entries.
-pub(crate) fn plan_bands(counts: &[u32], tiles_x: u32, capacity: u64) -> crate::Result<Vec<Band>> {
-    let rows = counts.len() as u32 / tiles_x.max(1);
-    let mut bands = Vec::new();
-    let mut start_row = 0u32;
-    let mut first_entry = 0u64;
-    let mut entries = 0u64;
-    for row in 0..rows {
-        let row_entries: u64 = counts[(row * tiles_x) as usize..((row + 1) * tiles_x) as usize]
-            .iter()
-            .map(|&c| u64::from(c))
-            .sum();
-        if row_entries > capacity {
-            return Err(crate::Error::input(format!(
-                "one row of tiles needs {row_entries} list entries ({} MiB), over the {} MiB a band may use on this device; \
-                 lower the frame size, enable fragment merging, or use a larger tile size",
-                (row_entries * ENTRY_BYTES) >> 20,
-                (capacity * ENTRY_BYTES) >> 20
-            )));
-        }
-        if entries + row_entries > capacity && row > start_row {
-            bands.push(Band {
-                first_tile: start_row * tiles_x,
-                end_tile: row * tiles_x,
-                first_entry: first_entry as u32,
-                entries,
-            });
-            start_row = row;
-            first_entry += entries;
-            entries = 0;
-        }
-        entries += row_entries;
-    }
-    bands.push(Band {
-        first_tile: start_row * tiles_x,
-        end_tile: rows * tiles_x,
-        first_entry: first_entry as u32,
-        entries,
-    });
-    Ok(bands)
-}
-
 /// Entries a list buffer holds.
 fn entries_in(entries: &Buffer) -> u32 {
     (entries.size_bytes() / ENTRY_BYTES).min(u64::from(u32::MAX)) as u32
-}
-
-/// Copies `data` into a host-visible buffer through its mapping.
-fn write_mapped<T: bytemuck::Pod>(buffer: &mut Buffer, data: &[T]) {
-    let bytes: &[u8] = bytemuck::cast_slice(data);
-    buffer
-        .mapped_bytes_mut()
-        .expect("upload buffers are host-visible")[..bytes.len()]
-        .copy_from_slice(bytes);
-}
-
-/// Writes `data` into a mapped buffer starting at element `offset` (elements of `T`).
-fn write_mapped_at<T: bytemuck::Pod>(buffer: &mut Buffer, offset: usize, data: &[T]) {
-    let size = std::mem::size_of::<T>();
-    let bytes: &[u8] = bytemuck::cast_slice(data);
-    buffer
-        .mapped_bytes_mut()
-        .expect("upload buffers are host-visible")[offset * size..offset * size + bytes.len()]
-        .copy_from_slice(bytes);
 }
 
 /// The contents of a host-visible read-back buffer.
@@ -1062,36 +980,4 @@ fn merge_repeated(timings: Timings) -> Timings {
         }
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn bands_cover_every_row_once_and_respect_capacity() {
-        let tiles_x = 3;
-        let counts = [5, 5, 5, 1, 1, 1, 9, 0, 0, 2, 2, 2];
-        // Rows hold 15, 3, 9 and 6 entries.
-        let bands = plan_bands(&counts, tiles_x, 15).unwrap();
-        assert_eq!(
-            bands
-                .iter()
-                .map(|b| (b.first_tile, b.end_tile, b.first_entry))
-                .collect::<Vec<_>>(),
-            [(0, 3, 0), (3, 9, 15), (9, 12, 27)]
-        );
-        let bands = plan_bands(&counts, tiles_x, 20).unwrap();
-        assert_eq!(
-            bands
-                .iter()
-                .map(|b| (b.first_tile, b.end_tile, b.first_entry))
-                .collect::<Vec<_>>(),
-            [(0, 6, 0), (6, 12, 18)]
-        );
-        assert!(bands.iter().all(|b| b.entries <= 20));
-        assert_eq!(plan_bands(&counts, tiles_x, 1000).unwrap().len(), 1);
-        let err = plan_bands(&counts, tiles_x, 14).unwrap_err().to_string();
-        assert!(err.contains("one row of tiles needs 15"), "{err}");
-    }
 }

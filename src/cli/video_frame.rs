@@ -1,0 +1,129 @@
+//! One frame of `ocular video`: the eye's pupil for it, and its panels, each through its own
+//! eye and spectacle. A panel's frame stays on the GPU (drawn in splat's own submission)
+//! unless the pupil follows the frame's luminance, which needs its pixels on the host.
+
+use super::video::VideoArgs;
+use crate::gpu::Context;
+use crate::image_io::{self, ImageRgba};
+use crate::optics::pupil::{watson_yellott_mm, Viewing};
+use crate::render::frame::{EyeState, FrameRenderer, Method};
+use crate::render::splat::FrameInput;
+use crate::render::{Frame, Rasterizer};
+use crate::scene::FrameState;
+use crate::Result;
+
+const IDENTITY: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
+
+/// Whether the pupil follows the frame's own mean luminance (neither `--pupil-mm` nor the
+/// scene gives a pupil or an adapting luminance).
+fn pupil_needs_frame(args: &VideoArgs, state: &FrameState<'_>) -> bool {
+    args.pupil_mm.or(state.pupil_mm).is_none() && state.luminance_cd_m2.is_none()
+}
+
+/// The pupil for `state` over a `width`×`height` field of `fov_y_deg`; `frame` is read only
+/// where [`pupil_needs_frame`] (and is then required).
+pub(super) fn pupil_for(
+    args: &VideoArgs,
+    state: &FrameState<'_>,
+    frame: Option<&Frame>,
+    (width, height): (u32, u32),
+    fov_y_deg: f64,
+) -> f64 {
+    if let Some(p) = args.pupil_mm.or(state.pupil_mm) {
+        return p;
+    }
+    let frame_luminance = |frame: &Frame| {
+        let sum: f64 = frame
+            .color
+            .iter()
+            .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
+            .sum();
+        sum / frame.color.len().max(1) as f64
+    };
+    let luminance = state
+        .luminance_cd_m2
+        .or(frame.map(frame_luminance))
+        .expect("callers read the frame back where the pupil follows its luminance");
+    let aspect = f64::from(width) / f64::from(height);
+    watson_yellott_mm(
+        luminance,
+        fov_y_deg * fov_y_deg * aspect,
+        args.age,
+        Viewing::OneEye,
+    )
+    .clamp(1.5, 8.0)
+}
+
+/// One splatted panel of `state`'s frame per renderer, each seen through its spectacle's
+/// magnification (`None`: none).
+pub(super) fn render_panels(
+    ctx: &Context,
+    rasterizer: &mut Rasterizer,
+    state: &FrameState<'_>,
+    size: (u32, u32),
+    (args, focus_d, fov_y_deg): (&VideoArgs, f64, f64),
+    renderers: &mut [FrameRenderer],
+    magnifications: &[Option<[[f64; 2]; 2]>],
+) -> Result<Vec<Vec<[f32; 4]>>> {
+    // Read back only where the pupil needs the pixels; then that frame also serves the
+    // panels seen without a spectacle.
+    let measured = if pupil_needs_frame(args, state) {
+        rasterizer.set_view_magnification(IDENTITY);
+        Some(rasterizer.render(ctx, state, size.0, size.1)?)
+    } else {
+        None
+    };
+    let eye_state = EyeState {
+        focus_d,
+        pupil_mm: pupil_for(args, state, measured.as_ref(), size, fov_y_deg),
+    };
+    let mut panels = Vec::new();
+    for (renderer, magnification) in renderers.iter_mut().zip(magnifications) {
+        let out = match (&measured, magnification) {
+            (Some(frame), None) => {
+                let input = FrameInput {
+                    width: size.0,
+                    height: size.1,
+                    color: &frame.color,
+                    depth_m: &frame.depth_m,
+                    fov_y_deg: state.camera.fov_y_deg,
+                    hidden_layers: &[],
+                };
+                renderer.render(&input, eye_state, Method::Splat)?
+            }
+            _ => {
+                rasterizer.set_view_magnification(magnification.unwrap_or(IDENTITY));
+                let mut frame = rasterizer.scene_frame(ctx, state, size);
+                renderer.render_recorded(&mut frame, eye_state)?
+            }
+        };
+        panels.push(out.color);
+    }
+    Ok(panels)
+}
+
+/// Panels side by side; labels drawn in the top-left corner of each panel.
+pub(super) fn compose(
+    width: u32,
+    height: u32,
+    panels: &[Vec<[f32; 4]>],
+    labels: Option<&[&str]>,
+) -> ImageRgba {
+    let n = panels.len() as u32;
+    let mut pixels = vec![[0.0f32, 0.0, 0.0, 1.0]; (width * n * height) as usize];
+    for (k, panel) in panels.iter().enumerate() {
+        for y in 0..height {
+            for x in 0..width {
+                pixels[(y * width * n + k as u32 * width + x) as usize] =
+                    panel[(y * width + x) as usize];
+            }
+        }
+    }
+    let mut image = ImageRgba::new(width * n, height, pixels);
+    if let Some(labels) = labels {
+        for (k, label) in labels.iter().enumerate() {
+            crate::psf::preview::draw_label(&mut image, k as u32 * width + 6, 6, label);
+        }
+    }
+    image
+}

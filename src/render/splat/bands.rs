@@ -1,0 +1,88 @@
+//! Bands: when a frame's tile lists exceed what one binding (or the memory budget) holds, the
+//! screen is processed in bands of whole tile rows, planned from the exact per-tile counts.
+
+use super::ENTRY_BYTES;
+
+/// A range of whole tile rows processed together, and where its entries start in the global
+/// (prefix-sum) numbering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Band {
+    pub first_tile: u32,
+    pub end_tile: u32,
+    pub first_entry: u32,
+    pub entries: u64,
+}
+
+/// Splits the screen into bands of whole tile rows whose lists fit `capacity` entries.
+pub(crate) fn plan_bands(counts: &[u32], tiles_x: u32, capacity: u64) -> crate::Result<Vec<Band>> {
+    let rows = counts.len() as u32 / tiles_x.max(1);
+    let mut bands = Vec::new();
+    let mut start_row = 0u32;
+    let mut first_entry = 0u64;
+    let mut entries = 0u64;
+    for row in 0..rows {
+        let row_entries: u64 = counts[(row * tiles_x) as usize..((row + 1) * tiles_x) as usize]
+            .iter()
+            .map(|&c| u64::from(c))
+            .sum();
+        if row_entries > capacity {
+            return Err(crate::Error::input(format!(
+                "one row of tiles needs {row_entries} list entries ({} MiB), over the {} MiB a band may use on this device; \
+                 lower the frame size, enable fragment merging, or use a larger tile size",
+                (row_entries * ENTRY_BYTES) >> 20,
+                (capacity * ENTRY_BYTES) >> 20
+            )));
+        }
+        if entries + row_entries > capacity && row > start_row {
+            bands.push(Band {
+                first_tile: start_row * tiles_x,
+                end_tile: row * tiles_x,
+                first_entry: first_entry as u32,
+                entries,
+            });
+            start_row = row;
+            first_entry += entries;
+            entries = 0;
+        }
+        entries += row_entries;
+    }
+    bands.push(Band {
+        first_tile: start_row * tiles_x,
+        end_tile: rows * tiles_x,
+        first_entry: first_entry as u32,
+        entries,
+    });
+    Ok(bands)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bands_cover_every_row_once_and_respect_capacity() {
+        let tiles_x = 3;
+        let counts = [5, 5, 5, 1, 1, 1, 9, 0, 0, 2, 2, 2];
+        // Rows hold 15, 3, 9 and 6 entries.
+        let bands = plan_bands(&counts, tiles_x, 15).unwrap();
+        assert_eq!(
+            bands
+                .iter()
+                .map(|b| (b.first_tile, b.end_tile, b.first_entry))
+                .collect::<Vec<_>>(),
+            [(0, 3, 0), (3, 9, 15), (9, 12, 27)]
+        );
+        let bands = plan_bands(&counts, tiles_x, 20).unwrap();
+        assert_eq!(
+            bands
+                .iter()
+                .map(|b| (b.first_tile, b.end_tile, b.first_entry))
+                .collect::<Vec<_>>(),
+            [(0, 6, 0), (6, 12, 18)]
+        );
+        assert!(bands.iter().all(|b| b.entries <= 20));
+        assert_eq!(plan_bands(&counts, tiles_x, 1000).unwrap().len(), 1);
+        let err = plan_bands(&counts, tiles_x, 14).unwrap_err().to_string();
+        assert!(err.contains("one row of tiles needs 15"), "{err}");
+    }
+}

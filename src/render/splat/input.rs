@@ -1,0 +1,202 @@
+//! Where a frame's colour and depth come from. A host frame (EXR, PNG, layered inputs) is
+//! written into persistent mapped staging buffers and copied into splat's input images; a
+//! frame the GPU makes itself (a rasterised scene, [`RecordedInput`]) is recorded into splat's
+//! own submission and taken into the input images by the input pass (glsl/render/splat/
+//! input.comp), so its pixels never cross to the host. Both feed the same passes after this.
+
+use crate::gpu::{
+    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
+};
+use crate::{Error, Result};
+
+use super::{FrameInput, FrameResources};
+
+/// A frame made on the GPU inside splat's submission.
+pub trait RecordedInput {
+    /// Width and height in pixels.
+    fn size(&self) -> (u32, u32);
+    /// Vertical field of view of the pinhole camera that makes the frame (degrees).
+    fn fov_y_deg(&self) -> f64;
+    /// Host-side work before recording (uploads, uniforms through their mapping); returns the
+    /// bytes it wrote for the device.
+    fn prepare(&mut self) -> Result<u64>;
+    /// Records the commands that make the frame and returns where they leave it: linear RGB
+    /// in an RGBA32F image with storage usage, and the distance along the view axis in metres
+    /// as one f32 per pixel, row-major, in a buffer.
+    fn record<'a>(&'a self, rec: &mut Recorder<'_>) -> GpuResult<(&'a Image, &'a Buffer)>;
+}
+
+pub(super) enum Source<'i, 'f> {
+    Host(&'i FrameInput<'f>),
+    Gpu(&'i mut dyn RecordedInput),
+}
+
+/// What splat needs to know about a frame before it runs.
+pub(super) struct Shape {
+    pub width: u32,
+    pub height: u32,
+    pub layers: u32,
+    pub fov_y_deg: f64,
+}
+
+/// Persistent, mapped staging buffers for host frames: colour, then depth, layer under layer.
+pub(super) struct Staging {
+    color: Buffer,
+    depth: Buffer,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct InputPush {
+    width: u32,
+    height: u32,
+    near_m: f32,
+}
+
+pub(super) struct InputPass {
+    pipeline: ComputePipeline,
+}
+
+impl InputPass {
+    pub fn new(ctx: &Context) -> GpuResult<Self> {
+        let pipeline = ComputePipeline::builder("input", crate::shaders::RENDER_SPLAT_INPUT_COMP)
+            .bindings(&[
+                BindingKind::StorageImage,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageImage,
+                BindingKind::StorageImage,
+            ])
+            .push_constants::<InputPush>()
+            .build(ctx)?;
+        Ok(InputPass { pipeline })
+    }
+}
+
+impl Source<'_, '_> {
+    /// The frame's size, layers and field, after checking that its parts agree.
+    pub fn shape(&self) -> Result<Shape> {
+        let shape = match self {
+            Source::Gpu(frame) => {
+                let (width, height) = frame.size();
+                Shape {
+                    width,
+                    height,
+                    layers: 1,
+                    fov_y_deg: frame.fov_y_deg(),
+                }
+            }
+            Source::Host(input) => {
+                let (w, h) = (input.width, input.height);
+                let pixels = w as usize * h as usize;
+                if w == 0 || h == 0 || input.color.len() != pixels || input.depth_m.len() != pixels
+                {
+                    return Err(Error::input(format!(
+                        "frame of {w}×{h} needs {pixels} colour and depth values (got {} and {})",
+                        input.color.len(),
+                        input.depth_m.len()
+                    )));
+                }
+                for (k, layer) in input.hidden_layers.iter().enumerate() {
+                    if layer.color.len() != pixels || layer.depth_m.len() != pixels {
+                        return Err(Error::input(format!(
+                            "hidden layer {} of a {w}×{h} frame needs {pixels} colour and depth \
+                             values (got {} and {})",
+                            k + 1,
+                            layer.color.len(),
+                            layer.depth_m.len()
+                        )));
+                    }
+                }
+                Shape {
+                    width: w,
+                    height: h,
+                    layers: 1 + input.hidden_layers.len() as u32,
+                    fov_y_deg: input.fov_y_deg,
+                }
+            }
+        };
+        if shape.width == 0 || shape.height == 0 {
+            return Err(Error::input(format!(
+                "frame size {}×{} has no pixels",
+                shape.width, shape.height
+            )));
+        }
+        crate::limits::FOV_Y_DEG
+            .check("vertical field of view", shape.fov_y_deg)
+            .map_err(Error::input)?;
+        Ok(shape)
+    }
+
+    /// Host-side work for the frame: a host frame goes into the staging buffers (made at the
+    /// first host frame of this size), a GPU frame prepares itself. Returns the bytes written
+    /// for the device.
+    pub fn stage(&mut self, ctx: &Context, frame: &mut FrameResources) -> Result<u64> {
+        let input = match self {
+            Source::Gpu(recorded) => return recorded.prepare(),
+            Source::Host(input) => input,
+        };
+        let pixels = frame.width as usize * frame.height as usize;
+        if frame.staging.is_none() {
+            let texels = (pixels * frame.layers as usize) as u64;
+            frame.staging = Some(Staging {
+                color: Buffer::new(ctx, "input colour staging", texels * 16, Residency::Upload)?,
+                depth: Buffer::new(ctx, "input depth staging", texels * 4, Residency::Upload)?,
+            });
+        }
+        let staging = frame.staging.as_mut().expect("made above");
+        write_mapped_at(&mut staging.color, 0, input.color);
+        write_mapped_at(&mut staging.depth, 0, input.depth_m);
+        for (k, layer) in input.hidden_layers.iter().enumerate() {
+            write_mapped_at(&mut staging.color, (k + 1) * pixels, layer.color);
+            write_mapped_at(&mut staging.depth, (k + 1) * pixels, layer.depth_m);
+        }
+        Ok((pixels * 20 * frame.layers as usize) as u64)
+    }
+
+    /// Records what leaves the frame in `frame.color_in` and `frame.depth_in`.
+    pub fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        pass: &InputPass,
+        frame: &FrameResources,
+    ) -> GpuResult<()> {
+        match self {
+            Source::Host(_) => {
+                let staging = frame.staging.as_ref().expect("staged before recording");
+                rec.begin_pass("upload");
+                rec.copy_buffer_to_image(&staging.color, &frame.color_in);
+                rec.copy_buffer_to_image(&staging.depth, &frame.depth_in);
+                Ok(())
+            }
+            Source::Gpu(recorded) => {
+                let (color, depth) = recorded.record(rec)?;
+                rec.begin_pass("input");
+                rec.dispatch(
+                    &pass.pipeline,
+                    &[
+                        Binding::Storage(color),
+                        Binding::Buffer(depth),
+                        Binding::Storage(&frame.color_in),
+                        Binding::Storage(&frame.depth_in),
+                    ],
+                    &InputPush {
+                        width: frame.width,
+                        height: frame.height,
+                        near_m: crate::render::focus::nearest_supported_m(),
+                    },
+                    [frame.width.div_ceil(8), frame.height.div_ceil(8), 1],
+                )
+            }
+        }
+    }
+}
+
+/// Writes `data` into a mapped buffer starting at element `offset` (elements of `T`).
+pub(super) fn write_mapped_at<T: bytemuck::Pod>(buffer: &mut Buffer, offset: usize, data: &[T]) {
+    let size = std::mem::size_of::<T>();
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    buffer
+        .mapped_bytes_mut()
+        .expect("upload buffers are host-visible")[offset * size..offset * size + bytes.len()]
+        .copy_from_slice(bytes);
+}
