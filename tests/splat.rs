@@ -641,6 +641,13 @@ fn tile_sizes_agree_and_frames_are_deterministic() {
             &scene,
             false,
         );
+        let worst = other
+            .color
+            .iter()
+            .zip(&base.color)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+            .fold(0.0f32, f32::max);
+        eprintln!("tile size {tile_size}: largest difference {worst:e}");
         assert_eq!(
             other.color, base.color,
             "tile size {tile_size} changes the image"

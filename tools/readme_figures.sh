@@ -20,6 +20,10 @@ rm -rf "$out/presbyopia"
     --side-by-side uncorrected --focus-sweep 0.4..0.4 --duration 0 --size 400x300 \
     -o "$out/presbyopia" && cp "$out/presbyopia/frame_000000.png" tools/figures/presbyopia.png
 
+# Off axis (README "Off axis at run time"): point lights across a 90° × 60° frame through the
+# wide-angle eye, on-axis PSF against --off-axis.
+python3 tools/field_figure.py --bin "$bin" --out tools/figures/off_axis_points.png
+
 for eye in healthy myopia astigmatism keratoconus; do
     "$bin" compare --scene primitives --eye "$eye" --size "$size" --json "$out/compare-$eye.json" \
         --maps "$out/maps-$eye"

@@ -297,8 +297,8 @@ mod tests {
     use super::*;
 
     /// Checked against the GLSL source of the convolution: a sampler, four read-only fragment
-    /// ranges (1, 6, 7, 8), three read-only list buffers and a write-only output image, under
-    /// the 128-byte frame parameters.
+    /// ranges (1, 7, 8, 9), three read-only list buffers, a write-only output image and the
+    /// read-only field table (6), under the 128-byte frame parameters.
     #[test]
     fn convolve_shader_reflects_as_written() {
         let r = reflect(crate::shaders::RENDER_SPLAT_CONVOLVE_COMP).unwrap();
@@ -322,6 +322,7 @@ mod tests {
                 (6, StorageBuffer, Read),
                 (7, StorageBuffer, Read),
                 (8, StorageBuffer, Read),
+                (9, StorageBuffer, Read),
             ]
         );
         // Merge reads and writes its fragments; tile count reads them and updates counts.

@@ -27,6 +27,9 @@ layout(std430, binding = 6) readonly buffer Field { vec4 field_header[2]; vec4 n
 // The tile side is fixed per pipeline, so the per-thread pixel arrays have a compile-time
 // size and live in registers (dynamic sizes cost CPU implementations such as lavapipe dearly).
 layout(constant_id = 0) const uint TILE = 8u;
+// Off axis (a field lattice of more than one node): a pipeline of its own, so that the on-axis
+// convolution carries none of the four-node code.
+layout(constant_id = 1) const uint OFF_AXIS = 0u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
@@ -81,7 +84,7 @@ vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
 // at the fragment's radius, mixed bilinearly in field angle.
 vec3 fragment_weight(uint j, Fragment f, vec2 d) {
     vec3 w;
-    if (field_nodes() == 1u) {
+    if (OFF_AXIS == 0u) {
         w = kernel_at(f, d, vec2(0.0));
     } else {
         w = vec3(0.0);
@@ -140,7 +143,7 @@ void main() {
         if (start + local_index < n) {
             Fragment f = load_fragment(entries[base + start + local_index].y);
             batch[local_index] = f;
-            if (field_nodes() > 1u) {
+            if (OFF_AXIS != 0u) {
                 uvec4 nodes;
                 vec4 weights;
                 field_corners(f.center, nodes, weights);

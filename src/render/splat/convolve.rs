@@ -14,7 +14,8 @@ pub(super) struct ConvolvePass {
 }
 
 impl ConvolvePass {
-    pub fn new(ctx: &Context, tile_size: u32) -> GpuResult<Self> {
+    /// `off_axis`: the four-node kernels of a field lattice (src/render/splat/field.rs).
+    pub fn new(ctx: &Context, tile_size: u32, off_axis: bool) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
                 .bindings(&kinds_with_fragments(
@@ -29,6 +30,7 @@ impl ConvolvePass {
                 ))
                 .push_constants::<FrameParams>()
                 .specialize(0, tile_size)
+                .specialize(1, u32::from(off_axis))
                 .build(ctx)?;
         Ok(ConvolvePass { pipeline })
     }

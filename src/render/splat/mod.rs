@@ -312,6 +312,9 @@ pub struct Splatter {
     convolve: convolve::ConvolvePass,
 }
 
+/// Largest tile side of the off-axis convolution.
+pub const MAX_OFF_AXIS_TILE: u32 = 16;
+
 pub(super) const FRAGMENT_BYTES: u64 = std::mem::size_of::<Fragment>() as u64;
 const ENTRY_BYTES: u64 = 8;
 
@@ -370,6 +373,15 @@ impl Splatter {
                 "shaderStorageImageWriteWithoutFormat (needed to build the PSF texture)".into(),
             )
             .into());
+        }
+        let off_axis = field_axes.is_some();
+        if off_axis && settings.tile_size > MAX_OFF_AXIS_TILE {
+            // Measured on lavapipe: the four-node convolution at 32-pixel tiles (16 pixels per
+            // thread) gives wrong tiles; 8 and 16 agree to the bit.
+            return Err(crate::Error::input(format!(
+                "--off-axis works with --tile-size 8 or 16 (asked {})",
+                settings.tile_size
+            )));
         }
         let layout = field::TextureLayout::new(&grid, field_axes.as_ref());
         let texel_bytes = match settings.texture_format {
@@ -438,7 +450,7 @@ impl Splatter {
             prefix_sum: prefix_sum::PrefixSumPass::new(ctx)?,
             tile_fill: tile_fill::TileFillPass::new(ctx)?,
             tile_sort: tile_sort::TileSortPass::new(ctx)?,
-            convolve: convolve::ConvolvePass::new(ctx, settings.tile_size)?,
+            convolve: convolve::ConvolvePass::new(ctx, settings.tile_size, off_axis)?,
             grid,
         })
     }
