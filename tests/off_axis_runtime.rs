@@ -125,7 +125,8 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
         .color;
     // The off-axis convolution is a pipeline of its own: tile sizes give the same image (32 is
     // refused: on lavapipe the four-node convolution at 16 pixels per thread went wrong).
-    for tile_size in [16] {
+    {
+        let tile_size = 16;
         let mut r = FrameRenderer::new(
             &ctx,
             eye.clone(),

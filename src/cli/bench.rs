@@ -122,6 +122,9 @@ struct Report {
     wall_ms_per_frame: Stat,
     list_entries: u64,
     max_radius_px: u32,
+    /// `--off-axis`: the field directions (degrees) the kernels were computed for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    field: Option<crate::psf::field::FieldAxes>,
     /// Per steady-state frame: queue submissions, GPU allocations, host↔device bytes.
     counters: Counters,
     baseline: Option<Baseline>,
@@ -298,6 +301,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         seconds_total: kernels.seconds,
     };
     let max_radius_px = kernels.grid.max_radius_px;
+    let field = kernels.field.as_ref().map(|f| f.plan.axes.clone());
     let baseline_inputs = args.baseline.then(|| (eye.clone(), kernels.clone()));
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = FrameInput {
@@ -397,6 +401,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         wall_ms_per_frame: stat("wall", &walls),
         list_entries,
         max_radius_px,
+        field,
         counters,
         baseline,
         methods,
@@ -439,6 +444,17 @@ fn print_table(r: &Report) {
         "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} list entries/frame",
         r.focus_d, r.pupil_mm, r.max_radius_px, r.list_entries
     );
+    if let Some(f) = &r.field {
+        println!(
+            "off axis: {} × {} field directions (h {:+.1}..{:+.1}°, v {:+.1}..{:+.1}°)",
+            f.h_deg.len(),
+            f.v_deg.len(),
+            f.h_deg[0],
+            f.h_deg[f.h_deg.len() - 1],
+            f.v_deg[0],
+            f.v_deg[f.v_deg.len() - 1]
+        );
+    }
     println!();
     let p = &r.precompute;
     if p.from_cache {

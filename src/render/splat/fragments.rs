@@ -118,6 +118,7 @@ impl FragmentsPass {
         Ok(FragmentsPass { pipeline })
     }
 
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
