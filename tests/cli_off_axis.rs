@@ -254,3 +254,40 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     refused(&kernels(&dir, &a), "--field-deg");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--off-axis` where it has no meaning is an input error before any kernel is computed:
+/// the slice method and the views truth stay on axis.
+#[test]
+fn off_axis_is_refused_where_it_does_not_apply() {
+    let dir = std::env::temp_dir().join(format!("ocular-off-axis-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("x.png");
+    let out = ocular(&[
+        "render",
+        "--scene",
+        "primitives",
+        "--size",
+        "64x36",
+        "--method",
+        "slices",
+        "--off-axis",
+        "--no-cache",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    refused(&out, "--off-axis");
+    assert!(!png.exists(), "no output for a refused render");
+    let out = ocular(&[
+        "compare",
+        "--scene",
+        "primitives",
+        "--size",
+        "64x36",
+        "--truth",
+        "views",
+        "--off-axis",
+        "--no-cache",
+    ]);
+    refused(&out, "--off-axis");
+    std::fs::remove_dir_all(&dir).ok();
+}
