@@ -6,9 +6,12 @@
 //! frame's lists exceed the device's storage-buffer binding limit or the memory budget, the
 //! screen is processed in bands of tile rows, so nothing is ever dropped.
 //!
-//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`.
+//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`; `construct` builds a
+//! splatter, `settings` holds its options, `field` the off-axis lattice, `bands` the planning
+//! of tile-row bands.
 
 mod bands;
+mod construct;
 mod convolve;
 mod field;
 mod fragments;
@@ -16,19 +19,21 @@ mod input;
 mod merge;
 mod prefix_sum;
 mod psf_texture;
+mod settings;
 mod tile_count;
 mod tile_fill;
 mod tile_sort;
 
 use crate::gpu::{
-    Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings,
+    Buffer, Context, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings,
 };
 use crate::psf::kernels::KernelGrid;
-use crate::render::blend::{BlendMode, BlendSettings};
+use crate::render::blend::BlendMode;
 
 use bands::plan_bands;
 pub use input::RecordedInput;
 pub use psf_texture::PsfTextureFormat;
+pub use settings::{MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
 
 /// Mirrors `struct Fragment` in glsl/common/splat.glsl (std430, 48 bytes).
 #[repr(C)]
@@ -77,102 +82,6 @@ pub(crate) struct FrameParams {
     pub layers: u32,
     pub pass_u: [u32; 4],
     pub pass_f: [f32; 4],
-}
-
-/// When and how strongly blurred blocks are merged into one fragment.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MergeSettings {
-    /// 0 = off, 1 = 2×2 blocks, 2 = 2×2 and then 4×4 blocks.
-    pub levels: u32,
-    /// Smallest blur radius (px, over the block and the channels) for a block to merge.
-    pub min_radius_px: f32,
-    /// Largest colour difference between two fragments of a block, per pixel of blur radius.
-    pub color_tolerance: f32,
-    /// Largest summed pairwise dioptre difference in a block, per pair and pixel of blur.
-    pub dioptre_tolerance: f32,
-}
-
-impl Default for MergeSettings {
-    fn default() -> Self {
-        // The seed paper's framework defaults.
-        MergeSettings {
-            levels: 1,
-            min_radius_px: 5.0,
-            color_tolerance: 0.10,
-            dioptre_tolerance: 0.01,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SplatSettings {
-    /// Screen tile side in pixels: 8, 16 or 32.
-    pub tile_size: u32,
-    pub texture_format: PsfTextureFormat,
-    pub merge: MergeSettings,
-    /// Upper bound on the tile-list buffer (bytes); bands are used beyond it. The device's
-    /// storage-buffer binding limit applies as well.
-    pub max_list_bytes: u64,
-    /// Upper bound on one binding of the fragment buffer (bytes); the device's limit applies
-    /// as well. A frame whose fragments exceed it is bound as up to four ranges.
-    pub max_fragment_binding_bytes: u64,
-    /// How fragments combine, and the wide-field geometry.
-    pub blend: BlendSettings,
-    /// The convolution stops walking a tile's list once every pixel's coverage reaches
-    /// 1 − ε in every channel (0 = never): what lies behind then adds at most ε of its light.
-    pub saturation_epsilon: f32,
-    /// Steady-state frames in one submission with the PSF texture kept while the eye's state
-    /// holds (false: every frame plans its lists and rebuilds the texture, as before; kept as
-    /// the baseline `ocular bench --baseline` measures against).
-    pub steady_state: bool,
-}
-
-impl Default for SplatSettings {
-    fn default() -> Self {
-        SplatSettings {
-            tile_size: 8,
-            texture_format: PsfTextureFormat::Rgba16Float,
-            merge: MergeSettings::default(),
-            max_list_bytes: 1 << 30,
-            max_fragment_binding_bytes: u64::MAX,
-            blend: BlendSettings::default(),
-            saturation_epsilon: DEFAULT_SATURATION_EPSILON,
-            steady_state: true,
-        }
-    }
-}
-
-/// Default early-exit threshold of the convolution.
-pub const DEFAULT_SATURATION_EPSILON: f32 = 1e-3;
-
-impl SplatSettings {
-    pub fn validate(&self) -> Result<(), String> {
-        if ![8, 16, 32].contains(&self.tile_size) {
-            return Err(format!(
-                "tile size {} is not one of 8, 16, 32",
-                self.tile_size
-            ));
-        }
-        if self.merge.levels > 2 {
-            return Err(format!(
-                "merge levels {} is not 0, 1 or 2",
-                self.merge.levels
-            ));
-        }
-        if !(self.merge.min_radius_px >= 0.0
-            && self.merge.color_tolerance >= 0.0
-            && self.merge.dioptre_tolerance >= 0.0)
-        {
-            return Err("merge thresholds must be non-negative numbers".into());
-        }
-        if !(self.saturation_epsilon.is_finite() && (0.0..0.5).contains(&self.saturation_epsilon)) {
-            return Err(format!(
-                "saturation epsilon {} is outside 0 to 0.5",
-                self.saturation_epsilon
-            ));
-        }
-        self.blend.validate()
-    }
 }
 
 /// A colour + depth frame on the CPU: row-major, top row first.
@@ -329,146 +238,6 @@ pub fn max_layers(ctx: &Context, width: u32, height: u32) -> u32 {
 }
 
 impl Splatter {
-    /// Uploads `grid` and builds every pass. The grid stays resident on the GPU.
-    pub fn new(
-        ctx: &Context,
-        grid: KernelGrid,
-        settings: SplatSettings,
-    ) -> crate::Result<Splatter> {
-        grid.validate()
-            .map_err(|e| crate::Error::Input(format!("kernel grid: {e}")))?;
-        Self::build(ctx, grid, Vec::new(), None, settings)
-    }
-
-    /// Off axis: every node's grid resident, one PSF-texture tile per node, and each
-    /// fragment's kernel mixed from the four nodes around its direction.
-    pub fn new_field(
-        ctx: &Context,
-        field: crate::psf::field_kernels::KernelField,
-        settings: SplatSettings,
-    ) -> crate::Result<Splatter> {
-        field
-            .validate()
-            .map_err(|e| crate::Error::Input(format!("field kernels: {e}")))?;
-        let centre = field.weights([0.0, 0.0]);
-        let nearest = centre
-            .iter()
-            .copied()
-            .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
-            .0;
-        let grid = field.grids[nearest].clone();
-        Self::build(ctx, grid, field.grids, Some(field.axes), settings)
-    }
-
-    fn build(
-        ctx: &Context,
-        grid: KernelGrid,
-        node_grids: Vec<KernelGrid>,
-        field_axes: Option<crate::psf::field::FieldAxes>,
-        settings: SplatSettings,
-    ) -> crate::Result<Splatter> {
-        settings.validate().map_err(crate::Error::Input)?;
-        if !ctx.can_write_images_without_format() {
-            return Err(GpuError::Unsupported(
-                "shaderStorageImageWriteWithoutFormat (needed to build the PSF texture)".into(),
-            )
-            .into());
-        }
-        let off_axis = field_axes.is_some();
-        if off_axis && settings.tile_size > MAX_OFF_AXIS_TILE {
-            // Measured on lavapipe: the four-node convolution at 32-pixel tiles (16 pixels per
-            // thread) gives wrong tiles; 8 and 16 agree to the bit.
-            return Err(crate::Error::input(format!(
-                "--off-axis works with --tile-size 8 or 16 (asked {})",
-                settings.tile_size
-            )));
-        }
-        let layout = field::TextureLayout::new(&grid, field_axes.as_ref());
-        let texel_bytes = match settings.texture_format {
-            PsfTextureFormat::Rgba16Float => 8,
-            PsfTextureFormat::Rgba32Float => 16,
-        };
-        layout.check(ctx, texel_bytes)?;
-        let nodes: &[KernelGrid] = if node_grids.is_empty() {
-            std::slice::from_ref(&grid)
-        } else {
-            &node_grids
-        };
-        let resident = nodes
-            .iter()
-            .map(|g| psf_texture::ResidentGrid::upload(ctx, g))
-            .collect::<crate::gpu::GpuResult<Vec<_>>>()?;
-        // Merging decides on the core radius: off axis the smallest over the nodes, so that a
-        // block merges only where every node's kernel allows it.
-        let mut core_radii: Vec<Vec<[f32; 3]>> =
-            grid.sets.iter().map(|s| s.core_radii_px()).collect();
-        for g in nodes {
-            for (mine, theirs) in core_radii.iter_mut().zip(&g.sets) {
-                for (m, t) in mine.iter_mut().zip(theirs.core_radii_px()) {
-                    for c in 0..3 {
-                        m[c] = m[c].min(t[c]);
-                    }
-                }
-            }
-        }
-        let texture = psf_texture::create_texture(ctx, layout.extent(), settings.texture_format)?;
-        let field_table =
-            field::FieldTable::new(ctx, &layout, field_axes.as_ref(), grid.objects.count)?;
-        let radii = Buffer::new(
-            ctx,
-            "object radii",
-            grid.objects.count as u64 * 16,
-            Residency::Device,
-        )?;
-        Ok(Splatter {
-            ctx: ctx.clone(),
-            settings,
-            resident,
-            layout,
-            field_table,
-            node_grids,
-            field_axes,
-            texture,
-            sampler: Sampler::linear(ctx, Edge::ZeroBorder)?,
-            radii,
-            radii_staging: Buffer::new(
-                ctx,
-                "object radii staging",
-                grid.objects.count as u64 * 16,
-                Residency::Upload,
-            )?,
-            texture_blend: None,
-            last_lists: None,
-            core_radii,
-            frame: None,
-            entries: None,
-            input: input::InputPass::new(ctx)?,
-            psf_texture: psf_texture::PsfTexturePass::new(ctx)?,
-            fragments_pass: fragments::FragmentsPass::new(ctx)?,
-            merge: merge::MergePass::new(ctx)?,
-            tile_count: tile_count::TileCountPass::new(ctx)?,
-            prefix_sum: prefix_sum::PrefixSumPass::new(ctx)?,
-            tile_fill: tile_fill::TileFillPass::new(ctx)?,
-            tile_sort: tile_sort::TileSortPass::new(ctx)?,
-            convolve: convolve::ConvolvePass::new(ctx, settings.tile_size, off_axis)?,
-            grid,
-        })
-    }
-
-    /// Every field node's grid (on axis: the grid alone).
-    fn nodes(&self) -> &[KernelGrid] {
-        if self.node_grids.is_empty() {
-            std::slice::from_ref(&self.grid)
-        } else {
-            &self.node_grids
-        }
-    }
-
-    /// The field lattice of off-axis kernels (None on axis).
-    pub fn field_axes(&self) -> Option<&crate::psf::field::FieldAxes> {
-        self.field_axes.as_ref()
-    }
-
     pub fn grid(&self) -> &KernelGrid {
         &self.grid
     }

@@ -1,0 +1,101 @@
+//! The splat runtime's settings: tiles, texture format, merging, list memory, blend and early
+//! exit.
+
+use super::psf_texture::PsfTextureFormat;
+use crate::render::blend::BlendSettings;
+
+/// When and how strongly blurred blocks are merged into one fragment.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MergeSettings {
+    /// 0 = off, 1 = 2×2 blocks, 2 = 2×2 and then 4×4 blocks.
+    pub levels: u32,
+    /// Smallest blur radius (px, over the block and the channels) for a block to merge.
+    pub min_radius_px: f32,
+    /// Largest colour difference between two fragments of a block, per pixel of blur radius.
+    pub color_tolerance: f32,
+    /// Largest summed pairwise dioptre difference in a block, per pair and pixel of blur.
+    pub dioptre_tolerance: f32,
+}
+
+impl Default for MergeSettings {
+    fn default() -> Self {
+        // The seed paper's framework defaults.
+        MergeSettings {
+            levels: 1,
+            min_radius_px: 5.0,
+            color_tolerance: 0.10,
+            dioptre_tolerance: 0.01,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SplatSettings {
+    /// Screen tile side in pixels: 8, 16 or 32.
+    pub tile_size: u32,
+    pub texture_format: PsfTextureFormat,
+    pub merge: MergeSettings,
+    /// Upper bound on the tile-list buffer (bytes); bands are used beyond it. The device's
+    /// storage-buffer binding limit applies as well.
+    pub max_list_bytes: u64,
+    /// Upper bound on one binding of the fragment buffer (bytes); the device's limit applies
+    /// as well. A frame whose fragments exceed it is bound as up to four ranges.
+    pub max_fragment_binding_bytes: u64,
+    /// How fragments combine, and the wide-field geometry.
+    pub blend: BlendSettings,
+    /// The convolution stops walking a tile's list once every pixel's coverage reaches
+    /// 1 − ε in every channel (0 = never): what lies behind then adds at most ε of its light.
+    pub saturation_epsilon: f32,
+    /// Steady-state frames in one submission with the PSF texture kept while the eye's state
+    /// holds (false: every frame plans its lists and rebuilds the texture, as before; kept as
+    /// the baseline `ocular bench --baseline` measures against).
+    pub steady_state: bool,
+}
+
+impl Default for SplatSettings {
+    fn default() -> Self {
+        SplatSettings {
+            tile_size: 8,
+            texture_format: PsfTextureFormat::Rgba16Float,
+            merge: MergeSettings::default(),
+            max_list_bytes: 1 << 30,
+            max_fragment_binding_bytes: u64::MAX,
+            blend: BlendSettings::default(),
+            saturation_epsilon: DEFAULT_SATURATION_EPSILON,
+            steady_state: true,
+        }
+    }
+}
+
+/// Default early-exit threshold of the convolution.
+pub const DEFAULT_SATURATION_EPSILON: f32 = 1e-3;
+
+impl SplatSettings {
+    pub fn validate(&self) -> Result<(), String> {
+        if ![8, 16, 32].contains(&self.tile_size) {
+            return Err(format!(
+                "tile size {} is not one of 8, 16, 32",
+                self.tile_size
+            ));
+        }
+        if self.merge.levels > 2 {
+            return Err(format!(
+                "merge levels {} is not 0, 1 or 2",
+                self.merge.levels
+            ));
+        }
+        if !(self.merge.min_radius_px >= 0.0
+            && self.merge.color_tolerance >= 0.0
+            && self.merge.dioptre_tolerance >= 0.0)
+        {
+            return Err("merge thresholds must be non-negative numbers".into());
+        }
+        if !(self.saturation_epsilon.is_finite() && (0.0..0.5).contains(&self.saturation_epsilon)) {
+            return Err(format!(
+                "saturation epsilon {} is outside 0 to 0.5",
+                self.saturation_epsilon
+            ));
+        }
+        self.blend.validate()
+    }
+}
