@@ -156,6 +156,12 @@ blend (depth groups), the pinhole's local layout and the PSFs with splat, so it 
 kernel approximations (interpolation over distance and radius, merging, half-float texels), \
 not the blend or the optics";
 
+/// What the off-axis reference has in common with off-axis splat.
+const FIELD_TRUTH_SHARES: &str = "ground truth: the exact PSF of every pixel's vergence and \
+direction (the eye traced for every 1° field bin, no lattice); it shares the blend, the \
+pinhole's local layout and the PSF computation of a direction with splat, so it judges the \
+field lattice and its interpolation as well as the kernel approximations, not the optics";
+
 /// What the views truth has in common with the methods it judges.
 const VIEWS_SHARES: &str = "ground truth: multi-view accumulation over the pupil (geometric \
 optics, rasterised from each pupil point, each channel shifted by the eye's ray aberration); it \
@@ -455,6 +461,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     );
     let truth_shares = if truth_method == Method::Views {
         VIEWS_SHARES
+    } else if args.splat.off_axis {
+        FIELD_TRUTH_SHARES
     } else {
         TRUTH_SHARES
     };
