@@ -29,8 +29,11 @@ for scene in ["primitives", "colonnade"]:
             cells.append(f"{m['psnr_db']:.2f} / {m['edge_band']['psnr_db']:.2f} ({m['edge_band']['mssim']:.4f})")
         print(f"| {scene} | {eye} | {r['views_convergence']['psnr_db']:.1f} | " + " | ".join(cells) + " |")
 PY
-# The README's SSIM maps (1280×720 run): one layer against two, primitives through the healthy eye.
+# The README's SSIM maps (1280×720 run): one layer against two, primitives through the healthy
+# eye and colonnade through the myopic one.
 if [ "$size" = "1280x720" ]; then
   cp "$out/primitives-healthy/ssim_splat.png" tools/figures/ssim-primitives-healthy-splat.png
   cp "$out/primitives-healthy/ssim_splat-layers.png" tools/figures/ssim-primitives-healthy-splat-layers.png
+  cp "$out/colonnade-myopia/ssim_splat.png" tools/figures/ssim-colonnade-myopia-splat.png
+  cp "$out/colonnade-myopia/ssim_splat-layers.png" tools/figures/ssim-colonnade-myopia-splat-layers.png
 fi
