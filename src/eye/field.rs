@@ -91,6 +91,30 @@ pub fn check_field_deg(field_deg: [f64; 2]) -> Result<(), EyeError> {
     }
 }
 
+/// Where the ray from the axis through `field_deg` leaves the traced field: `field_deg` scaled
+/// down (both angles alike) until the direction and each angle lie within [`MAX_FIELD_DEG`]
+/// (less a micro-degree, so that the result passes [`check_field_deg`]).
+pub fn shrink_into_traced_field(field_deg: [f64; 2]) -> [f64; 2] {
+    let limit = MAX_FIELD_DEG - 1e-6;
+    let inside = |m: f64| {
+        let f = [field_deg[0] * m, field_deg[1] * m];
+        eccentricity_deg(f) <= limit && f[0].abs() <= limit && f[1].abs() <= limit
+    };
+    if inside(1.0) {
+        return field_deg;
+    }
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if inside(m) {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    [field_deg[0] * lo, field_deg[1] * lo]
+}
+
 /// Object-space unit direction of field (h, v) degrees.
 pub fn field_direction(field_deg: [f64; 2]) -> V3 {
     let (x, y) = (

@@ -172,29 +172,13 @@ impl ExactFieldEye {
     }
 }
 
-/// `field_deg`, or where the ray from the axis through it leaves the traced field.
+/// `field_deg`, or where the ray from the axis through it leaves the traced field (as the
+/// runtime's lattice stops there).
 pub fn within_traced_field(field_deg: [f64; 2]) -> [f64; 2] {
-    use crate::eye::field::{check_field_deg, MAX_FIELD_DEG};
-    if check_field_deg(field_deg).is_ok() {
+    if crate::eye::field::check_field_deg(field_deg).is_ok() {
         return field_deg;
     }
-    let limit = MAX_FIELD_DEG - 1e-6;
-    let inside = |m: f64| {
-        let f = [field_deg[0] * m, field_deg[1] * m];
-        crate::eye::field::eccentricity_deg(f) <= limit
-            && f[0].abs() <= limit
-            && f[1].abs() <= limit
-    };
-    let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..60 {
-        let m = 0.5 * (lo + hi);
-        if inside(m) {
-            lo = m;
-        } else {
-            hi = m;
-        }
-    }
-    [field_deg[0] * lo, field_deg[1] * lo]
+    crate::eye::field::shrink_into_traced_field(field_deg)
 }
 
 impl ExactKernels for ExactFieldEye {

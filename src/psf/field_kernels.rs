@@ -61,6 +61,15 @@ impl KernelField {
         ]
     }
 
+    /// The node nearest the axis (the largest weight at field (0, 0)).
+    pub fn nearest_to_axis(&self) -> usize {
+        self.weights([0.0, 0.0])
+            .iter()
+            .copied()
+            .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
+            .0
+    }
+
     /// Every node's grid valid, on the same axes and radius, one per node, axes uniform.
     pub fn validate(&self) -> std::result::Result<(), String> {
         let [nh, nv] = self.node_counts();

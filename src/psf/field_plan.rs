@@ -11,7 +11,7 @@
 use super::axes::{GridAxes, Screen};
 use super::defocus::distance_of;
 use super::field::{frame_half_field_deg, FieldAxes};
-use crate::eye::field::{eccentricity_deg, measure_field, MAX_FIELD_DEG};
+use crate::eye::field::{measure_field, shrink_into_traced_field, MAX_FIELD_DEG};
 use crate::eye::{accommodate, Eye, OpticalSystem};
 use crate::{Error, Result};
 use serde::Serialize;
@@ -119,22 +119,10 @@ pub fn plan_field_axes(
         )));
     }
     let frame = frame_half_field_deg(fov_y_deg, width_px, height_px);
-    let mut half = frame;
     let mut notes = Vec::new();
     // The corners must stay inside the traced field: shrink both half-fields alike.
-    let limit = MAX_FIELD_DEG - 1e-6;
-    if eccentricity_deg(half) > limit || half[0] > limit || half[1] > limit {
-        let (mut lo, mut hi) = (0.0, 1.0);
-        for _ in 0..60 {
-            let m = 0.5 * (lo + hi);
-            let h = [frame[0] * m, frame[1] * m];
-            if eccentricity_deg(h) <= limit && h[0] <= limit && h[1] <= limit {
-                lo = m;
-            } else {
-                hi = m;
-            }
-        }
-        half = [frame[0] * lo, frame[1] * lo];
+    let half = shrink_into_traced_field(frame);
+    if half != frame {
         notes.push(format!(
             "the frame shows ±{:.1}° × ±{:.1}°; the grid stops at ±{:.1}° × ±{:.1}° (corners \
              {MAX_FIELD_DEG}° off axis), farther pixels use its edge",

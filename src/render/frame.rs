@@ -231,12 +231,7 @@ fn prepare_field_kernels(
     }
     warnings.extend(field_plan.notes.iter().cloned());
     warnings.extend(cache_warning(&out.cache));
-    let centre = out.field.weights([0.0, 0.0]);
-    let nearest = centre
-        .iter()
-        .copied()
-        .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
-        .0;
+    let nearest = out.field.nearest_to_axis();
     Ok(PreparedKernels {
         grid: out.field.grids[nearest].clone(),
         plan,

@@ -30,12 +30,7 @@ impl Splatter {
         field
             .validate()
             .map_err(|e| crate::Error::Input(format!("field kernels: {e}")))?;
-        let centre = field.weights([0.0, 0.0]);
-        let nearest = centre
-            .iter()
-            .copied()
-            .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a })
-            .0;
+        let nearest = field.nearest_to_axis();
         let grid = field.grids[nearest].clone();
         Self::build(ctx, grid, field.grids, Some(field.axes), settings)
     }
