@@ -1,6 +1,7 @@
 //! Layered inputs: depth peeling in the rasteriser, and splat over several layers. A blurred
 //! near card over a textured far wall shows the wall's texture through its blurred edge with
-//! two layers and not with one; a hidden layer that is empty changes nothing.
+//! two layers and not with one; a hidden layer that is empty changes nothing; what a floor
+//! buries stays hidden.
 
 mod common;
 
@@ -18,6 +19,18 @@ const H: u32 = 90;
 const FOV: f64 = 20.0;
 const WALL_M: f64 = 2.0;
 const CARD_M: f64 = 0.25;
+/// Blur of the synthetic eye: pixels of radius per dioptre of defocus.
+const PX_PER_D: f64 = 3.0;
+
+fn focal_px() -> f64 {
+    0.5 * f64::from(H) / (FOV.to_radians() / 2.0).tan()
+}
+
+/// The pupil whose geometric blur is PX_PER_D at this focal length (radius × focal length):
+/// the parallax that decides what a hidden point shows through must match the kernels.
+fn pupil_mm() -> f64 {
+    2000.0 * PX_PER_D / focal_px()
+}
 
 /// A self-lit checkerboard wall (squares of 5 px) at 2 m, optionally a grey self-lit card at
 /// 0.25 m whose right edge is the frame's centre column, and a sphere in front of the wall.
@@ -28,8 +41,7 @@ fn scene(card: bool, sphere: bool) -> Scene {
          color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 10.0\n",
         -WALL_M
     );
-    let focal_px = 0.5 * f64::from(H) / (FOV.to_radians() / 2.0).tan();
-    let square_m = 5.0 * WALL_M / focal_px;
+    let square_m = 5.0 * WALL_M / focal_px();
     for i in -20i32..20 {
         for j in -12i32..12 {
             if (i + j).rem_euclid(2) == 0 {
@@ -75,11 +87,26 @@ fn layers(scene: &Scene, k: u32) -> Vec<Frame> {
 }
 
 fn splat(frames: &[Frame]) -> Vec<[f32; 4]> {
-    let ctx = common::gpu();
     // focused on the wall (0.5 D), 3 px of blur per dioptre: the card blurs by 10.5 px
-    let eye = SyntheticEye::new(1.0 / WALL_M, 3.0);
-    let grid = eye.grid(DioptreAxis::spanning(0.125, 5.125, 41), 16, &[4.0], H);
-    let mut splatter = Splatter::new(&ctx, grid, SplatSettings::default()).unwrap();
+    splat_focused(frames, 1.0 / WALL_M, true)
+}
+
+/// Splat through the synthetic eye focused at `focus_d`, hidden light judged by the pupil's
+/// view past the nearer surfaces or (control) wherever nearer groups leave coverage.
+fn splat_focused(frames: &[Frame], focus_d: f64, pupil_visibility: bool) -> Vec<[f32; 4]> {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(focus_d, PX_PER_D);
+    let grid = eye.grid(
+        DioptreAxis::spanning(0.125, 5.125, 41),
+        16,
+        &[pupil_mm()],
+        H,
+    );
+    let settings = SplatSettings {
+        pupil_visibility,
+        ..SplatSettings::default()
+    };
+    let mut splatter = Splatter::new(&ctx, grid, settings).unwrap();
     let hidden: Vec<HiddenLayer<'_>> = frames[1..]
         .iter()
         .map(|f| HiddenLayer {
@@ -96,8 +123,8 @@ fn splat(frames: &[Frame]) -> Vec<[f32; 4]> {
         hidden_layers: &hidden,
     };
     let view = ViewState {
-        pupil_mm: 4.0,
-        focus_d: 1.0 / WALL_M,
+        pupil_mm: pupil_mm(),
+        focus_d,
     };
     let out = splatter.render(&input, view, false).unwrap().color;
     drop(splatter);
@@ -132,8 +159,7 @@ fn peeling_finds_the_wall_behind_the_card_and_the_sphere() {
         assert!((d - WALL_M as f32).abs() < 2e-3, "x {x}: layer 1 depth {d}");
     }
     // the sphere's centre pixel: its own back is skipped, the wall is next
-    let focal_px = 0.5 * f64::from(H) / (FOV.to_radians() / 2.0).tan();
-    let sx = (0.5 * f64::from(W) + focal_px * 0.2) as usize;
+    let sx = (0.5 * f64::from(W) + focal_px() * 0.2) as usize;
     assert!((l0.depth_m[at(sx, 45)] - 0.9).abs() < 0.01);
     let d = l1.depth_m[at(sx, 45)];
     assert!((d - WALL_M as f32).abs() < 2e-3, "behind the sphere: {d}");
@@ -200,5 +226,60 @@ fn an_empty_hidden_layer_changes_nothing() {
     assert!(
         darkened > 0.05 * peak,
         "a black far layer changed {darkened}"
+    );
+}
+
+/// A self-lit floor seen from 1 m up, looking at its point 8 m ahead, and a bright post
+/// standing at 8 m whose lower half is buried under the floor (as the colonnade's columns
+/// are): the buried half is the second layer below the post's foot.
+fn buried_post_scene() -> Scene {
+    let text = format!(
+        "[camera]\nposition = [0.0, 1.0, 0.0]\nlook_at = [0.0, 0.0, -8.0]\nfov_y_deg = {FOV}\n\
+         far_m = 100.0\n\n\
+         [[object]]\nkind = \"plane\"\nsize_m = [20.0, 80.0]\ntranslate = [0.0, 0.0, -40.0]\n\
+         rotate_deg = [-90.0, 0.0, 0.0]\ncolor = [0.0, 0.0, 0.0]\nemission_cd_m2 = 10.0\n\n\
+         [[object]]\nkind = \"cube\"\nsize_m = [0.3, 3.0, 0.3]\ntranslate = [0.0, 0.0, -8.0]\n\
+         color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 100.0\n"
+    );
+    Scene::from_toml(&text, "buried post", Path::new(".")).unwrap()
+}
+
+#[test]
+fn what_the_floor_buries_stays_hidden() {
+    let frames = layers(&buried_post_scene(), 2);
+    let at = |x: usize, y: usize| y * W as usize + x;
+    let (cx, foot) = (W as usize / 2, H as usize / 2);
+    // the peel found the buried half under the floor in front of the post's foot
+    let buried = (foot + 4..H as usize - 2)
+        .filter(|&y| frames[1].color[at(cx, y)][1] > 50.0)
+        .count();
+    assert!(buried > 20, "buried rows in layer 1: {buried}");
+    // focused at 0.5 m: floor and post blur by about 5.6 px
+    let one = splat_focused(&frames[..1], 2.0, true);
+    let two = splat_focused(&frames, 2.0, true);
+    let control = splat_focused(&frames, 2.0, false);
+    // the floor in front of the foot, past the post's blur, away from the frame's border
+    let rows = foot + 10..H as usize - 10;
+    let cols = cx - 12..cx + 12;
+    let floor = one[at(cx, H as usize - 12)][1];
+    let change = |img: &[[f32; 4]]| {
+        rows.clone()
+            .flat_map(|y| cols.clone().map(move |x| (x, y)))
+            .map(|(x, y)| (img[at(x, y)][1] - one[at(x, y)][1]).abs())
+            .fold(0.0f32, f32::max)
+    };
+    let (hidden, leaked) = (change(&two), change(&control));
+    eprintln!(
+        "floor {floor:.2}: two layers change it by at most {hidden:.3}; without the pupil test by {leaked:.3}"
+    );
+    assert!(
+        hidden < 0.01 * floor,
+        "two layers: {hidden} on a floor of {floor}"
+    );
+    // Negative control: the buried half shows through the floor when hidden light fills
+    // whatever coverage nearer groups leave.
+    assert!(
+        leaked > 0.05 * floor,
+        "control: {leaked} on a floor of {floor}"
     );
 }

@@ -10,7 +10,9 @@ struct Fragment {
     vec3 radius;   // blur radius in pixels per channel (R, G, B), clamped to Rmax
     float index;   // continuous index on the object-dioptre axis of the PSF texture
     vec2 center;   // footprint centre in pixels (a pixel's centre is x + 0.5)
-    uint size;     // 1 = single pixel, 2 or 4 = merged block; 0 = merged away
+    uint size;     // bits 0–6: 1 = single pixel, 2 or 4 = merged block, 0 = merged away or
+                   // empty; bit 7: a hidden-layer fragment, whose bits 8–31 say which of
+                   // its rays reach the pupil (pupil_share)
     float dioptre; // vergence along the pixel's ray (D, unclamped): the blend's grouping key
 };
 
@@ -132,6 +134,38 @@ vec3 level_of_radius(vec3 r) {
     return mix(fine, coarse, step(vec3(float(FINE_UNTIL_PX)) + 1e-6, r));
 }
 
+const uint HIDDEN_FRAGMENT = 0x80u;
+// 8 pupil directions × 3 rings of equal area (bit 3·direction + ring).
+const uint ALL_RAYS = 0xFFFFFFu;
+
+uint block_size(Fragment f) {
+    return f.size & 0x7Fu;
+}
+
+// Whether a fragment's light reaches pixel offset d. A hidden-layer fragment's light through
+// the pupil point at ρ·a in direction e lands near ρ·r·e from its centre (r: its blur radius;
+// the fragments pass oriented the rays to the kernel's side) and arrives only if that ray
+// passed the nearer surfaces (glsl/render/splat/fragments.comp, pupil_visibility). Bits
+// 3·i + l: direction i·45°, ring l of three of equal pupil area. Below a pixel of blur the
+// rays land together: the light arrives if any ray passes, and the nearer groups' coverage
+// takes the blocked share.
+float pupil_share(Fragment f, vec2 d) {
+    uint rays = f.size >> 8u;
+    if ((f.size & HIDDEN_FRAGMENT) == 0u || rays == ALL_RAYS) {
+        return 1.0;
+    }
+    if (rays == 0u) {
+        return 0.0;
+    }
+    float r = max(f.radius.r, max(f.radius.g, f.radius.b));
+    if (r < 1.0) {
+        return 1.0;
+    }
+    uint ring = min(uint(3.0 * dot(d, d) / (r * r)), 2u);
+    uint direction = uint(int(round(atan(d.y, d.x) * (4.0 / 3.14159265358979))) & 7);
+    return float((rays >> (3u * direction + ring)) & 1u);
+}
+
 // How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.
 // Kernels of radius r occupy (2r+1)² texels centred on the fragment; a merged fragment sits
 // half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further. Off
@@ -151,7 +185,7 @@ float fragment_reach(Fragment f) {
         float along = max(s.x * s.x, s.y * s.y) + abs(s.x * s.y);
         r = ceil((r + 1.0) * (1.0 / c.y + a * along)) - 1.0;
     }
-    return f.size > 1u ? r + 0.5 : r;
+    return block_size(f) > 1u ? r + 0.5 : r;
 }
 
 // Inclusive tile rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of

@@ -442,7 +442,12 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 1.0,
             ),
             mssim: quality.mean,
-            speedup_vs_reference: reference_seconds / frame.seconds.max(1e-12),
+            // a truth read with --truth-in has no time (NaN), nor a speed-up
+            speedup_vs_reference: if frame.seconds.is_nan() {
+                f64::NAN
+            } else {
+                reference_seconds / frame.seconds.max(1e-12)
+            },
             gpu_ms: frame.timings.as_ref().map(|t| t.total_ms()),
         });
         maps.push(quality.map);
@@ -495,9 +500,17 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         } else {
             format!("{:.2}", m.edge_band.psnr_db)
         };
+        let (seconds, speedup) = if m.seconds.is_nan() {
+            ("—".to_string(), "—".to_string())
+        } else {
+            (
+                format!("{:.3}", m.seconds),
+                format!("{:.1}", m.speedup_vs_reference),
+            )
+        };
         println!(
-            "  {:<13} {:>10} {:>10.4} {:>10.3} {:>12.1}   {:>28} {:>8.4}",
-            m.method, db, m.mssim, m.seconds, m.speedup_vs_reference, band_db, m.edge_band.mssim
+            "  {:<13} {:>10} {:>10.4} {:>10} {:>12}   {:>28} {:>8.4}",
+            m.method, db, m.mssim, seconds, speedup, band_db, m.edge_band.mssim
         );
     }
     if let Some(path) = &args.truth_out {

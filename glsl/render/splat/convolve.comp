@@ -4,11 +4,13 @@
 // pixel of the tile (src/render/blend.rs): per pixel and channel, consecutive fragments whose
 // vergences differ by at most the group tolerance form a group that adds linearly
 // (Cg += w·c, Ag += w); groups composite front to back, C += (1 − A)·Cg/max(Ag, 1),
-// A += (1 − A)·min(Ag, 1); the output is C / A. (blend_mode 1: the seed paper's per-fragment
-// C += (1 − A)·w·c, A += (1 − A)·w.) The kernel weight w comes from two trilinear lookups in
-// the PSF texture (floor and ceiling radius; the layer axis blends the two neighbouring object
-// distances), mixed by frac(radius), at the kernel offset of the local pinhole scale; off axis,
-// the kernels of the four field nodes around the fragment, mixed bilinearly (glsl/common/field.glsl).
+// A += (1 − A)·min(Ag, 1); the output is C / A. A hidden-layer fragment's light counts only
+// where its rays pass the nearer surfaces to the pupil (close_group, pupil_share).
+// (blend_mode 1: the seed paper's per-fragment C += (1 − A)·w·c, A += (1 − A)·w.) The kernel
+// weight w comes from two trilinear lookups in the PSF texture (floor and ceiling radius; the
+// layer axis blends the two neighbouring object distances), mixed by frac(radius), at the
+// kernel offset of the local pinhole scale; off axis, the kernels of the four field nodes
+// around the fragment, mixed bilinearly (glsl/common/field.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "splat.glsl"
 
@@ -96,13 +98,30 @@ vec3 fragment_weight(uint j, Fragment f, vec2 d) {
             }
         }
     }
-    if (f.size > 1u) {
+    uint size = block_size(f);
+    if (size > 1u) {
         // A merged block carries size² pixels' worth of the same light.
-        float n = float(f.size * f.size);
+        float n = float(size * size);
         w = frame.blend_mode == 0u ? n * w
                                    : vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(n));
     }
     return w;
+}
+
+// Composites the open group behind what is already there and empties it. Its coverage is
+// its kernels' summed weight (at most 1); its light is the mean over the weight that reaches
+// the pupil, which differs only where a hidden-layer fragment's rays are blocked
+// (pupil_share): the nearer groups' coverage already removed the blocked part of the pupil,
+// so the hidden light fills the rest with what those rays really meet. A group none of whose
+// light gets through takes no coverage.
+void close_group(inout vec3 C, inout vec3 A, inout vec3 Cg, inout vec3 Ag, inout vec3 Gg) {
+    vec3 reaches = step(vec3(1e-30), Gg);
+    vec3 coverage = min(Ag, vec3(1.0)) * reaches;
+    C += (vec3(1.0) - A) * coverage * Cg / max(Gg, vec3(1e-30));
+    A += (vec3(1.0) - A) * coverage;
+    Cg = vec3(0.0);
+    Ag = vec3(0.0);
+    Gg = vec3(0.0);
 }
 
 void main() {
@@ -124,6 +143,7 @@ void main() {
     vec3 A[PIXELS];
     vec3 Cg[PIXELS];     // the open group's light and coverage
     vec3 Ag[PIXELS];
+    vec3 Gg[PIXELS];     // the open group's weight of light that reaches the pupil
     float last[PIXELS];  // vergence of the last fragment that reached the pixel (−1: none)
     for (uint q = 0u; q < PIXELS; q++) {
         uvec2 pixel = uvec2(tx, ty) * TILE + gl_LocalInvocationID.xy + 8u * uvec2(q % PER_AXIS, q / PER_AXIS);
@@ -132,6 +152,7 @@ void main() {
         A[q] = vec3(0.0);
         Cg[q] = vec3(0.0);
         Ag[q] = vec3(0.0);
+        Gg[q] = vec3(0.0);
         last[q] = -1.0;
     }
     bool grouped = frame.blend_mode == 0u;
@@ -174,20 +195,18 @@ void main() {
                 } else {
                     w = fragment_weight(j, f, d);
                 }
+                float g = pupil_share(f, d);
                 if (grouped) {
                     if (last[q] >= 0.0 && abs(f.dioptre - last[q]) > frame.group_tolerance_d) {
-                        vec3 scale = vec3(1.0) / max(Ag[q], vec3(1.0));
-                        C[q] += (vec3(1.0) - A[q]) * Cg[q] * scale;
-                        A[q] += (vec3(1.0) - A[q]) * Ag[q] * scale;
-                        Cg[q] = vec3(0.0);
-                        Ag[q] = vec3(0.0);
+                        close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
                     }
-                    Cg[q] += w * f.color;
+                    Cg[q] += (w * g) * f.color;
                     Ag[q] += w;
+                    Gg[q] += w * g;
                     last[q] = f.dioptre;
                 } else {
-                    C[q] += (vec3(1.0) - A[q]) * w * f.color;
-                    A[q] += (vec3(1.0) - A[q]) * w;
+                    C[q] += (vec3(1.0) - A[q]) * (w * g) * f.color;
+                    A[q] += (vec3(1.0) - A[q]) * (w * g);
                 }
             }
         }
@@ -210,9 +229,7 @@ void main() {
     }
 
     for (uint q = 0u; q < PIXELS; q++) {
-        vec3 scale = vec3(1.0) / max(Ag[q], vec3(1.0));
-        C[q] += (vec3(1.0) - A[q]) * Cg[q] * scale;
-        A[q] += (vec3(1.0) - A[q]) * Ag[q] * scale;
+        close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
         uvec2 pixel = uvec2(centre[q]);
         if (pixel.x < frame.width && pixel.y < frame.height) {
             vec3 a = A[q];

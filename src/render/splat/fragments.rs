@@ -97,6 +97,20 @@ pub(super) fn kinds_with_fragments(
     all
 }
 
+/// How hidden-layer fragments are judged (pass_u.x / pass_f.xy of glsl/render/splat/
+/// fragments.comp).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct HiddenLight {
+    /// Keep only the light of each hidden fragment that passes the nearer surfaces on its
+    /// way to the pupil (false: all of it, away from the frame's border).
+    pub pupil_visibility: bool,
+    /// The vergence the eye is focused on (D): where this frame's kernels are smallest.
+    pub focus_d: f32,
+    /// Screen parallax (pixels) per dioptre for a ray through the pupil's edge: pupil
+    /// radius (m) × focal length (pixels).
+    pub parallax_px_per_d: f32,
+}
+
 pub(super) struct FragmentsPass {
     pipeline: ComputePipeline,
 }
@@ -128,7 +142,11 @@ impl FragmentsPass {
         radii: &Buffer,
         field_table: &Buffer,
         fragments: &FragmentStore,
+        hidden: HiddenLight,
     ) -> GpuResult<()> {
+        let mut p = *params;
+        p.pass_u = [u32::from(hidden.pupil_visibility), 0, 0, 0];
+        p.pass_f = [hidden.focus_d, hidden.parallax_px_per_d, 0.0, 0.0];
         rec.dispatch(
             &self.pipeline,
             &fragments.bind_with(
@@ -139,7 +157,7 @@ impl FragmentsPass {
                 ],
                 &[Binding::Buffer(field_table)],
             ),
-            params,
+            &p,
             [
                 params.width.div_ceil(8),
                 (params.height * params.layers).div_ceil(8),

@@ -436,6 +436,7 @@ impl Splatter {
         let frame = self.frame.as_ref().expect("ensured above");
         let mut params = self.params(frame);
         params.focal_px = projection.focal_px() as f32;
+        let hidden = self.hidden_light(&params, &radii, view);
         let tiles = frame.tiles_x * frame.tiles_y;
         let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
         let output_bytes = pixels as u64 * 16;
@@ -454,7 +455,8 @@ impl Splatter {
             let mut p = params;
             p.entry_capacity = entries_in(entries);
             let timings = ctx.submit(|rec| {
-                self.record_front(rec, &source, frame, &p, &blend, rebuild_texture)?;
+                let texture = rebuild_texture.then_some(&blend);
+                self.record_front(rec, &source, frame, &p, texture, hidden)?;
                 rec.copy_buffer_region(
                     &frame.counts,
                     u64::from(tiles) * 4,
@@ -506,7 +508,7 @@ impl Splatter {
 
         // Planning frame: everything up to the exact list sizes, read back to plan bands.
         let mut timings = ctx.submit(|rec| {
-            self.record_front(rec, &source, frame, &params, &blend, true)?;
+            self.record_front(rec, &source, frame, &params, Some(&blend), hidden)?;
             rec.end_pass();
             rec.copy_buffer_region(
                 &frame.counts,
@@ -602,7 +604,28 @@ impl Splatter {
         })
     }
 
-    /// Records the passes before the lists: inputs, PSF texture (when the blend changed),
+    /// What the fragments pass needs to judge hidden-layer light: the eye's focus (the object
+    /// vergence whose green kernel is smallest) and the parallax of the pupil's edge.
+    fn hidden_light(
+        &self,
+        params: &FrameParams,
+        radii: &[[f32; 4]],
+        view: ViewState,
+    ) -> fragments::HiddenLight {
+        let sharpest = radii
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1[1].total_cmp(&b.1[1]))
+            .map_or(0, |(i, _)| i);
+        fragments::HiddenLight {
+            pupil_visibility: self.settings.pupil_visibility,
+            focus_d: params.dioptre_min + params.dioptre_step * sharpest as f32,
+            parallax_px_per_d: (view.pupil_mm * 0.5e-3) as f32 * params.focal_px,
+        }
+    }
+
+    /// Records the passes before the lists: inputs, PSF texture (given the blend when it
+    /// changed),
     /// fragments, merging, tile counts and their prefix sum.
     fn record_front(
         &self,
@@ -610,8 +633,8 @@ impl Splatter {
         source: &input::Source<'_, '_>,
         frame: &FrameResources,
         params: &FrameParams,
-        blend: &crate::psf::kernels::GridBlend,
-        rebuild_texture: bool,
+        rebuild_texture: Option<&crate::psf::kernels::GridBlend>,
+        hidden: fragments::HiddenLight,
     ) -> crate::gpu::GpuResult<()> {
         source.record(rec, &self.input, frame)?;
         rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
@@ -620,7 +643,7 @@ impl Splatter {
             &self.field_table.buffer,
             self.field_table.buffer.size_bytes(),
         );
-        if rebuild_texture {
+        if let Some(blend) = rebuild_texture {
             rec.begin_pass("psf texture");
             for (node, resident) in self.resident.iter().enumerate() {
                 let tile = self.layout.tile_code(node);
@@ -637,6 +660,7 @@ impl Splatter {
             &self.radii,
             &self.field_table.buffer,
             &frame.fragments,
+            hidden,
         )?;
         if self.settings.merge.levels > 0 {
             rec.begin_pass("merge");

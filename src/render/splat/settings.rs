@@ -50,6 +50,10 @@ pub struct SplatSettings {
     /// holds (false: every frame plans its lists and rebuilds the texture, as before; kept as
     /// the baseline `ocular bench --baseline` measures against).
     pub steady_state: bool,
+    /// A hidden-layer fragment lends light only through the part of the pupil that sees it
+    /// past the nearer surfaces (false: wherever nearer depth groups leave coverage, as
+    /// before; kept as the control `tests/layers.rs` measures against).
+    pub pupil_visibility: bool,
 }
 
 impl Default for SplatSettings {
@@ -63,6 +67,7 @@ impl Default for SplatSettings {
             blend: BlendSettings::default(),
             saturation_epsilon: DEFAULT_SATURATION_EPSILON,
             steady_state: true,
+            pupil_visibility: true,
         }
     }
 }
