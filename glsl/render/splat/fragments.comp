@@ -3,6 +3,7 @@
 // blur radius per channel, interpolated between the two neighbouring object distances (and,
 // off axis, between the four neighbouring field nodes).
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 8
 #include "splat.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -5,7 +5,7 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
 };
 
-use super::{FrameParams, FRAGMENT_BYTES};
+use super::{FrameBlock, FrameUniform, FRAGMENT_BYTES};
 
 /// The frame's fragments: one buffer, bound to every pass as [`FRAGMENT_CHUNKS`] consecutive
 /// ranges (`FRAGMENT_BUFFERS` in glsl/common/splat.glsl). A 3840×2160 frame holds 380 MiB of
@@ -13,7 +13,7 @@ use super::{FrameParams, FRAGMENT_BYTES};
 /// ranges the device can bind instead of being refused.
 pub(super) struct FragmentStore {
     pub buffer: Buffer,
-    /// Fragments per range (the last may hold fewer); `FrameParams::fragments_per_chunk`.
+    /// Fragments per range (the last may hold fewer); `FrameUniform::fragments_per_chunk`.
     pub per_chunk: u32,
 }
 
@@ -113,7 +113,7 @@ impl FragmentsPass {
                     ],
                     &[BindingKind::StorageBuffer],
                 ))
-                .push_constants::<FrameParams>()
+                .uniform::<FrameUniform>()
                 .build(ctx)?;
         Ok(FragmentsPass { pipeline })
     }
@@ -122,27 +122,30 @@ impl FragmentsPass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
+        frame: FrameBlock<'_>,
         color: &Image,
         depth: &Image,
         radii: &Buffer,
         field_table: &Buffer,
         fragments: &FragmentStore,
     ) -> GpuResult<()> {
+        let mut bindings = fragments.bind_with(
+            &[
+                Binding::Storage(color),
+                Binding::Storage(depth),
+                Binding::Buffer(radii),
+            ],
+            &[Binding::Buffer(field_table)],
+        );
+        bindings.push(frame.binding());
+        let p = frame.values;
         rec.dispatch(
             &self.pipeline,
-            &fragments.bind_with(
-                &[
-                    Binding::Storage(color),
-                    Binding::Storage(depth),
-                    Binding::Buffer(radii),
-                ],
-                &[Binding::Buffer(field_table)],
-            ),
-            params,
+            &bindings,
+            &(),
             [
-                params.width.div_ceil(8),
-                (params.height * params.layers).div_ceil(8),
+                p.width.div_ceil(8),
+                (p.height * p.layers).div_ceil(8),
                 1,
             ],
         )

@@ -30,7 +30,7 @@ use crate::gpu::{
 use crate::psf::kernels::KernelGrid;
 use crate::render::blend::BlendMode;
 
-use bands::plan_bands;
+use bands::{plan_bands, BandPush};
 pub use input::RecordedInput;
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
@@ -49,11 +49,14 @@ pub struct Fragment {
     pub dioptre: f32,
 }
 
-/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (128 bytes, the
-/// smallest push-constant size every Vulkan device offers).
+/// Mirrors the uniform block `FrameUniform` in glsl/common/splat.glsl: what every pass and
+/// every dispatch of a frame shares, written once per frame through a persistent mapping
+/// (values that change between dispatches are each pass's own push constants). std140 lays
+/// out scalars as `repr(C)` does; the block's size is checked against each shader when its
+/// pipeline is built, and its members' names and offsets by a test.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct FrameParams {
+pub(crate) struct FrameUniform {
     pub width: u32,
     pub height: u32,
     pub tiles_x: u32,
@@ -67,21 +70,32 @@ pub(crate) struct FrameParams {
     pub merge_min_radius: f32,
     pub merge_color_tolerance: f32,
     pub merge_dioptre_tolerance: f32,
-    pub band_first_tile: u32,
-    pub band_end_tile: u32,
-    pub band_first_entry: u32,
     pub focal_px: f32,
     pub group_tolerance_d: f32,
     pub blend_mode: u32,
     pub wide_field: u32,
-    pub entry_capacity: u32,
     pub saturation_epsilon: f32,
     /// Fragments per bound range of the fragment buffer (`fragments::FragmentStore`).
     pub fragments_per_chunk: u32,
     /// Depth layers stacked in the inputs and the fragment buffer (1 = the visible surface).
     pub layers: u32,
-    pub pass_u: [u32; 4],
-    pub pass_f: [f32; 4],
+}
+
+/// Bytes of frame uniforms a splat frame sends the device.
+pub const FRAME_UNIFORM_BYTES: u64 = std::mem::size_of::<FrameUniform>() as u64;
+
+/// A frame's uniform values (for dispatch sizes on the host) and the buffer the shaders read
+/// them from (every pass's last binding).
+#[derive(Clone, Copy)]
+pub(super) struct FrameBlock<'a> {
+    pub values: &'a FrameUniform,
+    pub buffer: &'a Buffer,
+}
+
+impl<'a> FrameBlock<'a> {
+    pub fn binding(&self) -> crate::gpu::Binding<'a> {
+        crate::gpu::Binding::Buffer(self.buffer)
+    }
 }
 
 /// A colour + depth frame on the CPU: row-major, top row first.
@@ -178,6 +192,8 @@ struct FrameResources {
     cursors: Buffer,
     offsets: Buffer,
     block_sums: Buffer,
+    /// The frame's `FrameUniform`, written through its mapping before each submission.
+    uniform: Buffer,
     /// Persistent, mapped transfer buffers: host inputs in (made at the first host frame),
     /// the image and the list sizes out.
     staging: Option<input::Staging>,
@@ -317,6 +333,7 @@ impl Splatter {
                 tiles.div_ceil(1024) * 4,
                 Residency::Device,
             )?,
+            uniform: Buffer::new(ctx, "splat frame uniforms", FRAME_UNIFORM_BYTES, Residency::Upload)?,
             staging: None,
             readback_color: Buffer::new(
                 ctx,
@@ -336,9 +353,9 @@ impl Splatter {
         Ok(())
     }
 
-    fn params(&self, frame: &FrameResources) -> FrameParams {
+    fn params(&self, frame: &FrameResources, focal_px: f32) -> FrameUniform {
         let merge = &self.settings.merge;
-        FrameParams {
+        FrameUniform {
             width: frame.width,
             height: frame.height,
             tiles_x: frame.tiles_x,
@@ -352,22 +369,16 @@ impl Splatter {
             merge_min_radius: merge.min_radius_px,
             merge_color_tolerance: merge.color_tolerance,
             merge_dioptre_tolerance: merge.dioptre_tolerance,
-            band_first_tile: 0,
-            band_end_tile: frame.tiles_x * frame.tiles_y,
-            band_first_entry: 0,
-            focal_px: 1.0,
+            focal_px,
             group_tolerance_d: self.settings.blend.group_tolerance_d,
             blend_mode: match self.settings.blend.mode {
                 BlendMode::Grouped => 0,
                 BlendMode::PerFragment => 1,
             },
             wide_field: u32::from(self.settings.blend.wide_field),
-            entry_capacity: 0,
             saturation_epsilon: self.settings.saturation_epsilon,
             fragments_per_chunk: frame.fragments.per_chunk,
             layers: frame.layers,
-            pass_u: [0; 4],
-            pass_f: [0.0; 4],
         }
     }
 
@@ -427,15 +438,28 @@ impl Splatter {
         input::write_mapped_at(&mut self.radii_staging, 0, &radii);
         let table = self.field_table.contents(self.nodes(), &blend);
         input::write_mapped_at(&mut self.field_table.staging, 0, &table);
-        let upload_bytes = input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16;
         let projection = crate::render::projection::Projection {
             width: w,
             height: h,
             fov_y_deg: shape.fov_y_deg,
         };
+        let params = self.params(
+            self.frame.as_ref().expect("ensured above"),
+            projection.focal_px() as f32,
+        );
+        // Through the persistent mapping: submissions complete before `submit` returns, so no
+        // earlier frame still reads it.
+        let frame_mut = self.frame.as_mut().expect("ensured above");
+        input::write_mapped_at(&mut frame_mut.uniform, 0, std::slice::from_ref(&params));
+        let upload_bytes = input_bytes
+            + radii.len() as u64 * 16
+            + table.len() as u64 * 16
+            + FRAME_UNIFORM_BYTES;
         let frame = self.frame.as_ref().expect("ensured above");
-        let mut params = self.params(frame);
-        params.focal_px = projection.focal_px() as f32;
+        let block = FrameBlock {
+            values: &params,
+            buffer: &frame.uniform,
+        };
         let tiles = frame.tiles_x * frame.tiles_y;
         let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
         let output_bytes = pixels as u64 * 16;
@@ -451,10 +475,9 @@ impl Splatter {
         let mut sync = (0u32, 0u32);
         if one_submission {
             let entries = self.entries.as_ref().expect("checked above");
-            let mut p = params;
-            p.entry_capacity = entries_in(entries);
+            let band = BandPush::whole_frame(tiles, entries_in(entries));
             let timings = ctx.submit(|rec| {
-                self.record_front(rec, &source, frame, &p, &blend, rebuild_texture)?;
+                self.record_front(rec, &source, frame, block, &blend, rebuild_texture)?;
                 rec.copy_buffer_region(
                     &frame.counts,
                     u64::from(tiles) * 4,
@@ -469,7 +492,7 @@ impl Splatter {
                     u64::from(2 * tiles + 1) * 4,
                     4,
                 );
-                self.record_band(rec, frame, &p, entries, tiles)?;
+                self.record_band(rec, frame, block, &band, entries)?;
                 rec.end_pass();
                 rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
                 sync = rec.barrier_counts();
@@ -478,7 +501,7 @@ impl Splatter {
             submissions += 1;
             let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
             let (live, total) = (sizes[tiles as usize], sizes[2 * tiles as usize + 1]);
-            if u64::from(total) <= u64::from(p.entry_capacity) {
+            if total <= band.entry_capacity {
                 self.texture_blend = Some(blend);
                 self.last_lists = Some((u64::from(total), 1));
                 let stats = SplatStats {
@@ -506,7 +529,7 @@ impl Splatter {
 
         // Planning frame: everything up to the exact list sizes, read back to plan bands.
         let mut timings = ctx.submit(|rec| {
-            self.record_front(rec, &source, frame, &params, &blend, true)?;
+            self.record_front(rec, &source, frame, block, &blend, true)?;
             rec.end_pass();
             rec.copy_buffer_region(
                 &frame.counts,
@@ -546,15 +569,20 @@ impl Splatter {
         let largest_band = bands.iter().map(|b| b.entries).max().unwrap_or(0);
         self.ensure_entries(largest_band)?;
         let frame = self.frame.as_ref().expect("ensured above");
+        let block = FrameBlock {
+            values: &params,
+            buffer: &frame.uniform,
+        };
         let entries = self.entries.as_ref().expect("ensured above");
         let band_timings = ctx.submit(|rec| {
             for band in &bands {
-                let mut p = params;
-                p.band_first_tile = band.first_tile;
-                p.band_end_tile = band.end_tile;
-                p.band_first_entry = band.first_entry;
-                p.entry_capacity = entries_in(entries);
-                self.record_band(rec, frame, &p, entries, band.end_tile - band.first_tile)?;
+                let push = BandPush {
+                    first_tile: band.first_tile,
+                    end_tile: band.end_tile,
+                    first_entry: band.first_entry,
+                    entry_capacity: entries_in(entries),
+                };
+                self.record_band(rec, frame, block, &push, entries)?;
             }
             rec.end_pass();
             rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
@@ -609,7 +637,7 @@ impl Splatter {
         rec: &mut crate::gpu::Recorder<'_>,
         source: &input::Source<'_, '_>,
         frame: &FrameResources,
-        params: &FrameParams,
+        block: FrameBlock<'_>,
         blend: &crate::psf::kernels::GridBlend,
         rebuild_texture: bool,
     ) -> crate::gpu::GpuResult<()> {
@@ -625,13 +653,13 @@ impl Splatter {
             for (node, resident) in self.resident.iter().enumerate() {
                 let tile = self.layout.tile_code(node);
                 self.psf_texture
-                    .record(rec, params, resident, blend, tile, &self.texture)?;
+                    .record(rec, block, resident, blend, tile, &self.texture)?;
             }
         }
         rec.begin_pass("fragments");
         self.fragments_pass.record(
             rec,
-            params,
+            block,
             &frame.color_in,
             &frame.depth_in,
             &self.radii,
@@ -642,7 +670,7 @@ impl Splatter {
             rec.begin_pass("merge");
             self.merge.record(
                 rec,
-                params,
+                block,
                 self.settings.merge.levels,
                 &self.radii,
                 &frame.fragments,
@@ -651,11 +679,10 @@ impl Splatter {
         rec.begin_pass("tile count");
         rec.fill_buffer(&frame.counts, 0);
         self.tile_count
-            .record(rec, params, &frame.fragments, &frame.counts)?;
+            .record(rec, block, &frame.fragments, &frame.counts)?;
         rec.begin_pass("prefix sum");
         self.prefix_sum.record(
             rec,
-            params,
             frame.tiles_x * frame.tiles_y,
             &frame.counts,
             &frame.offsets,
@@ -669,15 +696,16 @@ impl Splatter {
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         frame: &FrameResources,
-        params: &FrameParams,
+        block: FrameBlock<'_>,
+        band: &BandPush,
         entries: &Buffer,
-        band_tiles: u32,
     ) -> crate::gpu::GpuResult<()> {
         rec.begin_pass("tile fill");
         rec.fill_buffer(&frame.cursors, 0);
         self.tile_fill.record(
             rec,
-            params,
+            block,
+            band,
             &frame.fragments,
             &frame.offsets,
             &frame.cursors,
@@ -686,8 +714,7 @@ impl Splatter {
         rec.begin_pass("tile sort");
         self.tile_sort.record(
             rec,
-            params,
-            band_tiles,
+            band,
             &frame.counts,
             &frame.offsets,
             entries,
@@ -695,8 +722,8 @@ impl Splatter {
         rec.begin_pass("convolve");
         self.convolve.record(
             rec,
-            params,
-            band_tiles,
+            block,
+            band,
             (&self.texture, &self.sampler),
             &self.field_table.buffer,
             &frame.fragments,
