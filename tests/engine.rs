@@ -118,7 +118,10 @@ fn steady_frames_are_one_submission_without_allocations() {
         // frame's uniforms
         assert!(
             next.stats.upload_bytes
-                <= u64::from(W * H) * 20 + 2 * 11 * 16 + 32 + ocular::render::splat::FRAME_UNIFORM_BYTES
+                <= u64::from(W * H) * 20
+                    + 2 * 11 * 16
+                    + 32
+                    + ocular::render::splat::FRAME_UNIFORM_BYTES
         );
         assert!(
             !names(&next).contains(&"psf texture".to_string()),

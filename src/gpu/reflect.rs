@@ -354,11 +354,12 @@ mod tests {
 
     /// Checked against the GLSL source of the convolution: a sampler, four read-only fragment
     /// ranges (1, 7, 8, 9), three read-only list buffers, a write-only output image and the
-    /// read-only field table (6), under the 128-byte frame parameters.
+    /// read-only field table (6), the frame's uniform block (10), under 16 bytes of band push
+    /// constants.
     #[test]
     fn convolve_shader_reflects_as_written() {
         let r = reflect(crate::shaders::RENDER_SPLAT_CONVOLVE_COMP).unwrap();
-        assert_eq!(r.push_constant_bytes, 128);
+        assert_eq!(r.push_constant_bytes, 16);
         let got: Vec<(u32, BindingKind, Access)> = r
             .bindings
             .iter()
@@ -379,8 +380,14 @@ mod tests {
                 (7, StorageBuffer, Read),
                 (8, StorageBuffer, Read),
                 (9, StorageBuffer, Read),
+                (10, UniformBuffer, Read),
             ]
         );
+        // the frame block: 20 four-byte scalars, std140-packed like repr(C)
+        let frame = r.bindings[10].block.as_ref().unwrap();
+        assert_eq!(frame.bytes, 80);
+        assert_eq!(frame.members[13], ("focal_px".to_string(), 52));
+        assert!(r.bindings[9].block.is_none());
         // Merge reads and writes its fragments; tile count reads them and updates counts.
         let merge = reflect(crate::shaders::RENDER_SPLAT_MERGE_COMP).unwrap();
         assert_eq!(merge.bindings[0].access, Read);

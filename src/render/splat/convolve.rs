@@ -5,9 +5,9 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Sampler,
 };
 
+use super::bands::BandPush;
 use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::tile_fill::per_tile_groups;
-use super::bands::BandPush;
 use super::{FrameBlock, FrameUniform};
 
 pub(super) struct ConvolvePass {

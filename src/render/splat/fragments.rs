@@ -143,11 +143,7 @@ impl FragmentsPass {
             &self.pipeline,
             &bindings,
             &(),
-            [
-                p.width.div_ceil(8),
-                (p.height * p.layers).div_ceil(8),
-                1,
-            ],
+            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
 }

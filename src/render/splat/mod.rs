@@ -11,6 +11,8 @@
 //! of tile-row bands.
 
 mod bands;
+#[cfg(test)]
+mod block_layouts;
 mod construct;
 mod convolve;
 mod field;
@@ -333,7 +335,12 @@ impl Splatter {
                 tiles.div_ceil(1024) * 4,
                 Residency::Device,
             )?,
-            uniform: Buffer::new(ctx, "splat frame uniforms", FRAME_UNIFORM_BYTES, Residency::Upload)?,
+            uniform: Buffer::new(
+                ctx,
+                "splat frame uniforms",
+                FRAME_UNIFORM_BYTES,
+                Residency::Upload,
+            )?,
             staging: None,
             readback_color: Buffer::new(
                 ctx,
@@ -451,10 +458,8 @@ impl Splatter {
         // earlier frame still reads it.
         let frame_mut = self.frame.as_mut().expect("ensured above");
         input::write_mapped_at(&mut frame_mut.uniform, 0, std::slice::from_ref(&params));
-        let upload_bytes = input_bytes
-            + radii.len() as u64 * 16
-            + table.len() as u64 * 16
-            + FRAME_UNIFORM_BYTES;
+        let upload_bytes =
+            input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16 + FRAME_UNIFORM_BYTES;
         let frame = self.frame.as_ref().expect("ensured above");
         let block = FrameBlock {
             values: &params,
@@ -712,13 +717,8 @@ impl Splatter {
             entries,
         )?;
         rec.begin_pass("tile sort");
-        self.tile_sort.record(
-            rec,
-            band,
-            &frame.counts,
-            &frame.offsets,
-            entries,
-        )?;
+        self.tile_sort
+            .record(rec, band, &frame.counts, &frame.offsets, entries)?;
         rec.begin_pass("convolve");
         self.convolve.record(
             rec,

@@ -35,11 +35,7 @@ impl TileCountPass {
             &self.pipeline,
             &bindings,
             &(),
-            [
-                p.width.div_ceil(8),
-                (p.height * p.layers).div_ceil(8),
-                1,
-            ],
+            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
 }

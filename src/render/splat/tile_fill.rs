@@ -3,8 +3,8 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
-use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::bands::BandPush;
+use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::{FrameBlock, FrameUniform};
 
 pub(super) struct TileFillPass {
@@ -54,11 +54,7 @@ impl TileFillPass {
             &self.pipeline,
             &bindings,
             band,
-            [
-                p.width.div_ceil(8),
-                (p.height * p.layers).div_ceil(8),
-                1,
-            ],
+            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
 }

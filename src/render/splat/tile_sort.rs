@@ -3,8 +3,8 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
-use super::tile_fill::per_tile_groups;
 use super::bands::BandPush;
+use super::tile_fill::per_tile_groups;
 
 pub(super) struct TileSortPass {
     pipeline: ComputePipeline,
