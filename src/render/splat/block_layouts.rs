@@ -55,12 +55,14 @@ fn band_push() -> BlockLayout {
 }
 
 /// (shader, its frame block binding if it has one, its push-constant block if it has one)
-fn splat_shaders() -> Vec<(
+type ShaderBlocks = (
     &'static str,
     &'static [u8],
     Option<u32>,
     Option<BlockLayout>,
-)> {
+);
+
+fn splat_shaders() -> Vec<ShaderBlocks> {
     use crate::shaders::*;
     vec![
         ("fragments", RENDER_SPLAT_FRAGMENTS_COMP, Some(8), None),

@@ -30,6 +30,7 @@ impl TileFillPass {
     }
 
     /// `cursors` must be zeroed; `entries` holds the band's lists.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
