@@ -1,8 +1,9 @@
 #version 460
-// Exclusive prefix sum of the per-tile counts into list offsets, in three dispatches
-// (phase, `PrefixSumPush` in src/render/splat/prefix_sum.rs): 0 scans blocks of 1024 counts and records each block's total; 1 scans the block
-// totals in one workgroup (any number of blocks); 2 adds each block's base and writes the grand
-// total after the last offset. It needs no frame values: only its own push constants.
+// Exclusive prefix sum of the per-tile counts into list offsets, in three dispatches (the
+// phase, `PrefixSumPush` in src/render/splat/prefix_sum.rs): 0 scans blocks of 1024 counts and
+// records each block's total; 1 scans the block totals in one workgroup (any number of
+// blocks); 2 adds each block's base and writes the grand total after the last offset. It needs
+// no frame values, so it binds no frame block: only its own push constants.
 
 layout(local_size_x = 256) in;
 
