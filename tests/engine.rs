@@ -114,8 +114,15 @@ fn steady_frames_are_one_submission_without_allocations() {
         );
         let image_bytes = u64::from(W * H) * 16;
         assert_eq!(next.stats.readback_bytes, image_bytes + 8);
-        // the pixels, the radii and the field table (its header and one node's radii)
-        assert!(next.stats.upload_bytes <= u64::from(W * H) * 20 + 2 * 11 * 16 + 32);
+        // the pixels, the radii, the field table (its header and one node's radii) and the
+        // frame's uniforms
+        assert!(
+            next.stats.upload_bytes
+                <= u64::from(W * H) * 20
+                    + 2 * 11 * 16
+                    + 32
+                    + ocular::render::splat::FRAME_UNIFORM_BYTES
+        );
         assert!(
             !names(&next).contains(&"psf texture".to_string()),
             "the PSF texture was rebuilt for an unchanged eye state"

@@ -16,8 +16,15 @@ struct Fragment {
     float dioptre; // vergence along the pixel's ray (D, unclamped): the blend's grouping key
 };
 
-// Per-frame constants, identical for every pass. Mirrors `FrameParams` in mod.rs.
-layout(push_constant) uniform FrameParams {
+// Per-frame constants, identical for every pass and every dispatch of a frame: a uniform
+// buffer the host writes once per frame through its mapping (values that change between the
+// dispatches of a frame are each pass's own push constants). Each shader defines FRAME_BINDING,
+// its last binding, before including this file. std140: scalars only, so the layout is that of
+// `FrameUniform` in src/render/splat/mod.rs (a vec3 or an array here would need padding there).
+#ifndef FRAME_BINDING
+#error "define FRAME_BINDING (the binding of the frame's uniform block) before splat.glsl"
+#endif
+layout(std140, binding = FRAME_BINDING) uniform FrameUniform {
     uint width;
     uint height;
     uint tiles_x;
@@ -31,19 +38,13 @@ layout(push_constant) uniform FrameParams {
     float merge_min_radius;
     float merge_color_tolerance;
     float merge_dioptre_tolerance;
-    uint band_first_tile;  // tiles [band_first_tile, band_end_tile) are processed this band
-    uint band_end_tile;
-    uint band_first_entry; // global list offset of the band's first entry
     float focal_px;        // (H/2)/tan(fov_y/2)
     float group_tolerance_d;
     uint blend_mode;       // 0 = depth groups, 1 = the seed paper's per-fragment blend
     uint wide_field;       // 1 = vergence along rays and kernels at the local pinhole scale
-    uint entry_capacity;   // entries the list buffer holds: lists past it are not touched
     float saturation_epsilon; // convolution stops once every pixel's coverage is ≥ 1 − ε
     uint fragments_per_chunk; // see FRAGMENT_BUFFERS
     uint layers;           // depth layers stacked in the inputs and fragments (1 = visible only)
-    uvec4 pass_u;          // pass-specific values (see each pass)
-    vec4 pass_f;
 } frame;
 
 // A frame's fragments live in one buffer, bound as four consecutive ranges of
@@ -202,23 +203,6 @@ ivec4 fragment_tiles(Fragment f) {
     }
     int t = int(frame.tile_size);
     return ivec4(p0 / t, p1 / t);
-}
-
-// Sort key of a list entry: depth bits (positive floats order like their bit patterns), then
-// the fragment index, so that equal depths sort deterministically.
-uvec2 entry_key(float depth, uint fragment) {
-    return uvec2(floatBitsToUint(max(depth, 0.0)), fragment);
-}
-
-// A tile's list lies wholly inside the list buffer (a frame recorded in one submission with a
-// list buffer from an earlier frame may overflow it; the host then renders it again in bands).
-bool list_fits(uint offset, uint count) {
-    uint start = offset - frame.band_first_entry;
-    return start <= frame.entry_capacity && count <= frame.entry_capacity - start;
-}
-
-bool key_less(uvec2 a, uvec2 b) {
-    return a.x < b.x || (a.x == b.x && a.y < b.y);
 }
 
 #endif

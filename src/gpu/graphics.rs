@@ -357,6 +357,7 @@ impl<'a> GraphicsPipelineBuilder<'a> {
             &shared,
             self.name,
             &self.kinds,
+            &[],
             self.push_constant_bytes,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
             &[self.vertex_spirv, self.fragment_spirv],

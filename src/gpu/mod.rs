@@ -28,6 +28,6 @@ pub use graphics::{
 };
 pub use image::{Edge, Image, ImageUsage, Sampler, TexelFormat};
 pub use pipeline::{Binding, BindingKind, ComputePipeline, ComputePipelineBuilder};
-pub use reflect::{reflect, Access, ReflectedBinding, Reflection};
+pub use reflect::{reflect, Access, BlockLayout, ReflectedBinding, Reflection};
 
 pub use ash::vk;

@@ -87,6 +87,7 @@ impl Layout {
         shared: &Arc<DeviceShared>,
         name: &str,
         kinds: &[BindingKind],
+        uniform_bytes: &[(u32, u32)],
         push_constant_bytes: u32,
         stages: vk::ShaderStageFlags,
         modules: &[&[u8]],
@@ -101,7 +102,8 @@ impl Layout {
                 "{push_constant_bytes} bytes of push constants in pass \"{name}\" (limit {max_push})"
             )));
         }
-        let access = check_against_shaders(kinds, push_constant_bytes, modules).map_err(usage)?;
+        let access = check_against_shaders(kinds, uniform_bytes, push_constant_bytes, modules)
+            .map_err(usage)?;
         let mut out = Layout {
             shared: shared.clone(),
             kinds: kinds.to_vec(),
@@ -159,10 +161,12 @@ impl Drop for Layout {
     }
 }
 
-/// The declared bindings (0, 1, … of set 0) and push-constant size against the union of what
-/// `modules` declare; returns each binding's access over all stages.
+/// The declared bindings (0, 1, … of set 0), uniform-block sizes (binding, bytes) and
+/// push-constant size against the union of what `modules` declare; returns each binding's
+/// access over all stages.
 fn check_against_shaders(
     kinds: &[BindingKind],
+    uniform_bytes: &[(u32, u32)],
     push_constant_bytes: u32,
     modules: &[&[u8]],
 ) -> Result<Vec<Access>, String> {
@@ -184,6 +188,17 @@ fn check_against_shaders(
                     "binding {} is a {:?} in the shader, declared as {:?}",
                     b.binding, b.kind, kinds[b.binding as usize]
                 ));
+            }
+            if let (Some(block), Some(&(_, bytes))) = (
+                &b.block,
+                uniform_bytes.iter().find(|(i, _)| *i == b.binding),
+            ) {
+                if block.bytes != bytes {
+                    return Err(format!(
+                        "the uniform block at binding {} is {} bytes in the shader, the pass's struct {bytes}",
+                        b.binding, block.bytes
+                    ));
+                }
             }
             *slot = Some(match *slot {
                 Some((k, a)) if a != b.access => (k, Access::ReadWrite),
@@ -216,6 +231,8 @@ pub struct ComputePipelineBuilder<'a> {
     name: &'a str,
     spirv: &'a [u8],
     kinds: Vec<BindingKind>,
+    /// (binding, bytes) of the uniform blocks declared with a struct.
+    uniform_bytes: Vec<(u32, u32)>,
     push_constant_bytes: u32,
     specialization: Vec<(u32, u32)>,
 }
@@ -227,6 +244,7 @@ impl ComputePipeline {
             name,
             spirv,
             kinds: Vec::new(),
+            uniform_bytes: Vec::new(),
             push_constant_bytes: 0,
             specialization: Vec::new(),
         }
@@ -252,9 +270,19 @@ impl ComputePipeline {
 }
 
 impl<'a> ComputePipelineBuilder<'a> {
-    /// Declares bindings 0, 1, 2, … of set 0, in order.
+    /// Declares the next bindings of set 0 (from 0, 1, 2, …), in order.
     pub fn bindings(mut self, kinds: &[BindingKind]) -> Self {
-        self.kinds = kinds.to_vec();
+        self.kinds.extend_from_slice(kinds);
+        self
+    }
+
+    /// Declares the next binding as a uniform buffer holding a `T` (a `#[repr(C)]` Pod struct
+    /// that mirrors the GLSL block with std140 layout); the block's size is checked against
+    /// the shader's when the pipeline is built.
+    pub fn uniform<T: bytemuck::Pod>(mut self) -> Self {
+        self.uniform_bytes
+            .push((self.kinds.len() as u32, std::mem::size_of::<T>() as u32));
+        self.kinds.push(BindingKind::UniformBuffer);
         self
     }
 
@@ -284,6 +312,7 @@ impl<'a> ComputePipelineBuilder<'a> {
             &shared,
             self.name,
             &self.kinds,
+            &self.uniform_bytes,
             self.push_constant_bytes,
             vk::ShaderStageFlags::COMPUTE,
             &[self.spirv],

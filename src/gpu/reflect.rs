@@ -25,11 +25,21 @@ impl Access {
 }
 
 /// One binding of descriptor set 0.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReflectedBinding {
     pub binding: u32,
     pub kind: BindingKind,
     pub access: Access,
+    /// Uniform buffers: the block's layout (a Rust struct that mirrors it is checked against it).
+    pub block: Option<BlockLayout>,
+}
+
+/// The explicit layout of a uniform or push-constant block: its size and its members' names
+/// (from the module's debug names; empty when stripped) and offsets, in declaration order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BlockLayout {
+    pub bytes: u32,
+    pub members: Vec<(String, u32)>,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -38,9 +48,12 @@ pub struct Reflection {
     pub bindings: Vec<ReflectedBinding>,
     /// Bytes of the push-constant block (0 without one).
     pub push_constant_bytes: u32,
+    /// The push-constant block's layout (None without one).
+    pub push_constants: Option<BlockLayout>,
 }
 
 mod op {
+    pub const MEMBER_NAME: u32 = 6;
     pub const DECORATE: u32 = 71;
     pub const MEMBER_DECORATE: u32 = 72;
     pub const TYPE_INT: u32 = 21;
@@ -98,6 +111,15 @@ struct Module {
     member_decorations: std::collections::HashMap<(u32, u32, u32), u32>,
     /// (variable, pointer type, storage class)
     variables: Vec<(u32, u32, u32)>,
+    /// (struct, member) → debug name.
+    member_names: std::collections::HashMap<(u32, u32), String>,
+}
+
+/// A SPIR-V literal string: UTF-8 bytes packed little-endian into words, nul-terminated.
+fn literal_string(words: &[u32]) -> String {
+    let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+    String::from_utf8_lossy(&bytes[..end]).into_owned()
 }
 
 /// Reads `spirv` (bytes of a SPIR-V module). Errors name what is malformed.
@@ -124,6 +146,10 @@ fn parse(mut words: &[u32]) -> Result<Module, String> {
         match opcode {
             op::DECORATE => {
                 m.decorations.insert((at(0), at(1)), at(2));
+            }
+            op::MEMBER_NAME if a.len() > 2 => {
+                m.member_names
+                    .insert((at(0), at(1)), literal_string(&a[2..]));
             }
             op::MEMBER_DECORATE => {
                 m.member_decorations.insert((at(0), at(1), at(2)), at(3));
@@ -218,6 +244,29 @@ impl Module {
         })
     }
 
+    /// Size, member names and offsets of an explicitly laid-out block.
+    fn block_layout(&self, id: u32) -> Result<BlockLayout, String> {
+        let count = match self.types.get(&id) {
+            Some(Type::Struct(m)) => m.len() as u32,
+            _ => 0,
+        };
+        let members = (0..count)
+            .map(|i| {
+                let name = self.member_names.get(&(id, i)).cloned().unwrap_or_default();
+                let offset = self
+                    .member_decorations
+                    .get(&(id, i, deco::OFFSET))
+                    .copied()
+                    .ok_or("block member without an offset")?;
+                Ok((name, offset))
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok(BlockLayout {
+            bytes: self.size_of(id)?,
+            members,
+        })
+    }
+
     /// Access of a buffer block: read-only when every member is NonWritable, write-only when
     /// every member is NonReadable (glslang's `readonly` / `writeonly` on a block).
     fn block_access(&self, variable: u32, block: u32) -> Access {
@@ -240,7 +289,9 @@ impl Module {
                 continue;
             };
             if storage == class::PUSH_CONSTANT {
-                out.push_constant_bytes = self.size_of(pointee)?;
+                let block = self.block_layout(pointee)?;
+                out.push_constant_bytes = block.bytes;
+                out.push_constants = Some(block);
                 continue;
             }
             let Some(&binding) = self.decorations.get(&(var, deco::BINDING)) else {
@@ -249,6 +300,7 @@ impl Module {
             if self.decorations.get(&(var, deco::DESCRIPTOR_SET)).copied() != Some(0) {
                 continue;
             }
+            let mut block = None;
             let (kind, access) = match (storage, self.types.get(&pointee)) {
                 (class::STORAGE_BUFFER, _) => {
                     (BindingKind::StorageBuffer, self.block_access(var, pointee))
@@ -256,7 +308,10 @@ impl Module {
                 (class::UNIFORM, _) if self.has(pointee, deco::BUFFER_BLOCK) => {
                     (BindingKind::StorageBuffer, self.block_access(var, pointee))
                 }
-                (class::UNIFORM, _) => (BindingKind::UniformBuffer, Access::Read),
+                (class::UNIFORM, _) => {
+                    block = Some(self.block_layout(pointee)?);
+                    (BindingKind::UniformBuffer, Access::Read)
+                }
                 (class::UNIFORM_CONSTANT, Some(Type::SampledImage)) => {
                     (BindingKind::SampledImage, Access::Read)
                 }
@@ -277,6 +332,7 @@ impl Module {
                 binding,
                 kind,
                 access,
+                block,
             });
         }
         out.bindings.sort_by_key(|b| b.binding);
@@ -298,11 +354,12 @@ mod tests {
 
     /// Checked against the GLSL source of the convolution: a sampler, four read-only fragment
     /// ranges (1, 7, 8, 9), three read-only list buffers, a write-only output image and the
-    /// read-only field table (6), under the 128-byte frame parameters.
+    /// read-only field table (6), the frame's uniform block (10), under 16 bytes of band push
+    /// constants.
     #[test]
     fn convolve_shader_reflects_as_written() {
         let r = reflect(crate::shaders::RENDER_SPLAT_CONVOLVE_COMP).unwrap();
-        assert_eq!(r.push_constant_bytes, 128);
+        assert_eq!(r.push_constant_bytes, 16);
         let got: Vec<(u32, BindingKind, Access)> = r
             .bindings
             .iter()
@@ -323,8 +380,14 @@ mod tests {
                 (7, StorageBuffer, Read),
                 (8, StorageBuffer, Read),
                 (9, StorageBuffer, Read),
+                (10, UniformBuffer, Read),
             ]
         );
+        // the frame block: 20 four-byte scalars, std140-packed like repr(C)
+        let frame = r.bindings[10].block.as_ref().unwrap();
+        assert_eq!(frame.bytes, 80);
+        assert_eq!(frame.members[13], ("focal_px".to_string(), 52));
+        assert!(r.bindings[9].block.is_none());
         // Merge reads and writes its fragments; tile count reads them and updates counts.
         let merge = reflect(crate::shaders::RENDER_SPLAT_MERGE_COMP).unwrap();
         assert_eq!(merge.bindings[0].access, Read);

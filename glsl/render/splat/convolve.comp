@@ -12,7 +12,9 @@
 // kernel offset of the local pinhole scale; off axis, the kernels of the four field nodes
 // around the fragment, mixed bilinearly (glsl/common/field.glsl).
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 10
 #include "splat.glsl"
+#include "band.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -125,8 +127,8 @@ void close_group(inout vec3 C, inout vec3 A, inout vec3 Cg, inout vec3 Ag, inout
 }
 
 void main() {
-    uint tile = frame.band_first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
-    if (tile >= frame.band_end_tile) {
+    uint tile = band.first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+    if (tile >= band.end_tile) {
         return;
     }
     uint tx = tile % frame.tiles_x;
@@ -135,7 +137,7 @@ void main() {
     if (!list_fits(offsets[tile], n)) {
         return;
     }
-    uint base = offsets[tile] - frame.band_first_entry;
+    uint base = offsets[tile] - band.first_entry;
     uint local_index = gl_LocalInvocationIndex;
 
     vec2 centre[PIXELS];

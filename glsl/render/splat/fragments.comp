@@ -3,6 +3,7 @@
 // blur radius per channel, interpolated between the two neighbouring object distances (and,
 // off axis, between the four neighbouring field nodes).
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 8
 #include "splat.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -17,14 +18,14 @@ FRAGMENT_STORE
 layout(std430, binding = 4) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
 #include "field.glsl"
 
-// pass_u.x: 1 = hidden fragments keep only the light that passes the nearer surfaces on its
-// way to the pupil (pupil_visibility); 0 = all of it, away from the frame's border.
-// pass_f.x: the vergence the eye is focused on (D, where the kernels are smallest);
-// pass_f.y: pixels of screen parallax per dioptre for a ray through the pupil's edge
-// (pupil radius × focal length in pixels).
-#define PUPIL_VISIBILITY frame.pass_u.x
-#define FOCUS_D frame.pass_f.x
-#define PARALLAX_PX_PER_D frame.pass_f.y
+layout(push_constant) uniform FragmentsPush {
+    // 1: a hidden fragment keeps only the light that passes the nearer surfaces on its way to
+    // the pupil (pupil_visibility); 0: all of it, away from the frame's border
+    uint pupil_visibility;
+    float focus_d;           // the vergence the eye is focused on (D): its kernels are smallest there
+    float parallax_px_per_d; // screen parallax per dioptre of a ray through the pupil's edge
+                             // (pupil radius × focal length in pixels)
+} push;
 
 const float PI = 3.14159265358979;
 
@@ -51,7 +52,7 @@ float visible_vergence(ivec2 q) {
 uint pupil_visibility(ivec2 p, float v_hidden) {
     const float RHO[3] = float[3](0.57735027, 0.81649658, 1.0);
     float v_top = frame.dioptre_min + frame.dioptre_step * float(frame.object_count - 1u);
-    float k = max(PARALLAX_PX_PER_D, 1e-6);
+    float k = max(push.parallax_px_per_d, 1e-6);
     float reach = min(RHO[2] * k * max(v_top - v_hidden, 0.0) + 1.0,
                       2.0 * float(frame.max_radius) + 2.0);
     float tolerance = frame.group_tolerance_d;
@@ -148,12 +149,12 @@ void main() {
     // infinite depth is the background at optical infinity).
     f.size = layer > 0u && !finite_depth ? 0u : 1u;
     if (layer > 0u && f.size != 0u) {
-        if (PUPIL_VISIBILITY != 0u) {
+        if (push.pupil_visibility != 0u) {
             uint mask = pupil_visibility(ivec2(p), dioptre);
             // Kept as seen from the kernel's side: light through the pupil point u lands at
             // u·(focus − vergence)·f from the point's pixel, so a point nearer than the focus
             // lands on the side opposite its pupil point.
-            if (dioptre > FOCUS_D) {
+            if (dioptre > push.focus_d) {
                 mask = ((mask >> 12u) | (mask << 12u)) & ALL_RAYS;
             }
             // A fragment none of whose rays pass still takes its place in its depth group's

@@ -1,13 +1,18 @@
 #version 460
 // Merges blocks of similar, strongly blurred fragments into one fragment, in place: the
 // merged fragment takes the block's top-left slot, the others are marked merged away (size 0).
-// pass_u.x is the block size this dispatch makes: 2 merges 2×2 single pixels, 4 merges 2×2
-// already-merged 2×2 blocks. Thresholds scale with the block's smallest blur radius: the more
+// One dispatch per block size (`MergePush` in src/render/splat/merge.rs): 2 merges 2×2 single
+// pixels, 4 merges 2×2 already-merged 2×2 blocks. Thresholds scale with the block's smallest blur radius: the more
 // blur, the less a small difference in colour or dioptre can show.
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 5
 #include "splat.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(push_constant) uniform MergePush {
+    uint block_size; // side of the blocks this dispatch makes (2 or 4)
+} push;
 
 // Per object distance: natural radius per channel (xyz) and the smallest core radius (w).
 layout(std430, binding = 0) readonly buffer Radii { vec4 radii[]; };
@@ -26,7 +31,7 @@ float min3(vec3 v) { return min(v.x, min(v.y, v.z)); }
 float max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
 void main() {
-    uint size = frame.pass_u.x;
+    uint size = push.block_size;
     uint child = size / 2u;
     uvec2 block = gl_GlobalInvocationID.xy;
     uvec2 origin = block * size;

@@ -1,12 +1,16 @@
 #version 460
-// Exclusive prefix sum of the per-tile counts into list offsets, in three dispatches
-// (pass_u.x): 0 scans blocks of 1024 counts and records each block's total; 1 scans the block
-// totals in one workgroup (any number of blocks); 2 adds each block's base and writes the grand
-// total after the last offset. pass_u.y is the number of counts.
-#extension GL_GOOGLE_include_directive : require
-#include "splat.glsl"
+// Exclusive prefix sum of the per-tile counts into list offsets, in three dispatches (the
+// phase, `PrefixSumPush` in src/render/splat/prefix_sum.rs): 0 scans blocks of 1024 counts and
+// records each block's total; 1 scans the block totals in one workgroup (any number of
+// blocks); 2 adds each block's base and writes the grand total after the last offset. It needs
+// no frame values, so it binds no frame block: only its own push constants.
 
 layout(local_size_x = 256) in;
+
+layout(push_constant) uniform PrefixSumPush {
+    uint phase; // 0, 1 or 2 (above)
+    uint count; // number of counts scanned
+} push;
 
 layout(std430, binding = 0) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 1) buffer Offsets { uint offsets[]; };   // count + 1 entries
@@ -41,8 +45,8 @@ uint scan_block(uint t, inout uint v[4]) {
 }
 
 void main() {
-    uint phase = frame.pass_u.x;
-    uint n = frame.pass_u.y;
+    uint phase = push.phase;
+    uint n = push.count;
     uint t = gl_LocalInvocationID.x;
     uint v[4];
     if (phase == 0u) {

@@ -5,6 +5,7 @@
 // that half floats keep their precision (a kernel's mean texel becomes ~1); the convolution
 // pass divides it back out.
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 5
 #include "splat.glsl"
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -16,15 +17,23 @@ layout(std430, binding = 2) readonly buffer Set2 { float set2[]; };
 layout(std430, binding = 3) readonly buffer Set3 { float set3[]; };
 layout(binding = 4) writeonly uniform image3D psf_texture;
 
-// pass_f: the four corner weights; pass_u: (first level, end level, first texel) of the chunk,
-// and the field node's tile: column | row << 10 | data offset << 20 (src/render/splat/field.rs).
-// A tile is pitch = side + 2·offset texels square, its kernels start `offset` texels in: off
-// axis a zero margin keeps bilinear reads at a kernel's edge out of the neighbouring tile.
-#define WEIGHTS frame.pass_f
-#define FIRST_LEVEL frame.pass_u.x
-#define END_LEVEL frame.pass_u.y
-#define FIRST_TEXEL frame.pass_u.z
-#define TILE_CODE frame.pass_u.w
+// One dispatch per chunk of radius levels and field node (`PsfTexturePush` in
+// src/render/splat/psf_texture.rs). The tile code is column | row << 10 | data offset << 20
+// (src/render/splat/field.rs). A tile is pitch = side + 2·offset texels square, its kernels
+// start `offset` texels in: off axis a zero margin keeps bilinear reads at a kernel's edge out
+// of the neighbouring tile.
+layout(push_constant) uniform PsfTexturePush {
+    uint first_level;    // the chunk's radius levels [first_level, end_level)
+    uint end_level;
+    uint first_texel;    // index of the chunk's first texel in a whole kernel set
+    uint tile_code;
+    vec4 corner_weights; // bilinear weights of the four grid states (unused ones zero)
+} push;
+#define WEIGHTS push.corner_weights
+#define FIRST_LEVEL push.first_level
+#define END_LEVEL push.end_level
+#define FIRST_TEXEL push.first_texel
+#define TILE_CODE push.tile_code
 
 uint texels_below(uint r) {
     return r * (4u * r * r - 1u) / 3u;

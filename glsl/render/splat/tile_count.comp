@@ -2,6 +2,7 @@
 // Counts, per screen tile, the fragments whose kernel can reach a pixel of that tile; the
 // element after the last tile counts the live (not merged-away) fragments.
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 5
 #include "splat.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

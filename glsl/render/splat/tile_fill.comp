@@ -3,7 +3,9 @@
 // reach, at the tile's offset from the prefix sum. The fill order depends on scheduling; the
 // sort pass makes the lists deterministic.
 #extension GL_GOOGLE_include_directive : require
+#define FRAME_BINDING 7
 #include "splat.glsl"
+#include "band.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -25,14 +27,14 @@ void main() {
     }
     ivec4 tiles = fragment_tiles(f);
     // Bands are whole tile rows: clip the rectangle to the band's rows.
-    int band_y0 = int(frame.band_first_tile / frame.tiles_x);
-    int band_y1 = int((frame.band_end_tile - 1u) / frame.tiles_x);
+    int band_y0 = int(band.first_tile / frame.tiles_x);
+    int band_y1 = int((band.end_tile - 1u) / frame.tiles_x);
     for (int ty = max(tiles.y, band_y0); ty <= min(tiles.w, band_y1); ty++) {
         for (int tx = tiles.x; tx <= tiles.z; tx++) {
             uint tile = uint(ty) * frame.tiles_x + uint(tx);
             uint slot = atomicAdd(cursors[tile], 1u);
-            uint at = offsets[tile] - frame.band_first_entry + slot;
-            if (at < frame.entry_capacity) {
+            uint at = offsets[tile] - band.first_entry + slot;
+            if (at < band.entry_capacity) {
                 entries[at] = entry_key(f.depth, index);
             }
         }

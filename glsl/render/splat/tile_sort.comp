@@ -5,7 +5,7 @@
 // every comparator touching the padding can be skipped. Lists up to 2048 entries sort in
 // shared memory; longer ones sort in place in global memory (slower, but nothing is dropped).
 #extension GL_GOOGLE_include_directive : require
-#include "splat.glsl"
+#include "band.glsl"
 
 layout(local_size_x = 256) in;
 
@@ -21,15 +21,15 @@ const uint RANK_SORT_LIMIT = 512u;
 shared uvec2 keys[SHARED_CAPACITY];
 
 void main() {
-    uint tile = frame.band_first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
-    if (tile >= frame.band_end_tile) {
+    uint tile = band.first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+    if (tile >= band.end_tile) {
         return; // whole workgroup: no barrier is skipped by some threads only
     }
     uint n = counts[tile];
     if (n < 2u || !list_fits(offsets[tile], n)) {
         return;
     }
-    uint base = offsets[tile] - frame.band_first_entry;
+    uint base = offsets[tile] - band.first_entry;
     uint t = gl_LocalInvocationID.x;
     uint m = 1u;
     while (m < n) m <<= 1u;

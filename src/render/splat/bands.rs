@@ -13,6 +13,35 @@ pub(crate) struct Band {
     pub entries: u64,
 }
 
+/// Push constants of the list passes (tile fill, tile sort, convolve): the band they work on.
+/// Mirrors `BandPush` in glsl/common/band.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct BandPush {
+    pub first_tile: u32,
+    pub end_tile: u32,
+    /// Global list offset of the band's first entry.
+    pub first_entry: u32,
+    /// Entries the list buffer holds: lists past it are not touched (the host re-plans).
+    pub entry_capacity: u32,
+}
+
+impl BandPush {
+    /// The whole frame as one band.
+    pub fn whole_frame(tiles: u32, entry_capacity: u32) -> BandPush {
+        BandPush {
+            first_tile: 0,
+            end_tile: tiles,
+            first_entry: 0,
+            entry_capacity,
+        }
+    }
+
+    pub fn tiles(&self) -> u32 {
+        self.end_tile - self.first_tile
+    }
+}
+
 /// Splits the screen into bands of whole tile rows whose lists fit `capacity` entries.
 pub(crate) fn plan_bands(counts: &[u32], tiles_x: u32, capacity: u64) -> crate::Result<Vec<Band>> {
     let rows = counts.len() as u32 / tiles_x.max(1);

@@ -5,9 +5,10 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Sampler,
 };
 
+use super::bands::BandPush;
 use super::fragments::{kinds_with_fragments, FragmentStore};
 use super::tile_fill::per_tile_groups;
-use super::FrameParams;
+use super::{FrameBlock, FrameUniform};
 
 pub(super) struct ConvolvePass {
     pipeline: ComputePipeline,
@@ -28,7 +29,8 @@ impl ConvolvePass {
                         BindingKind::StorageBuffer,
                     ],
                 ))
-                .push_constants::<FrameParams>()
+                .uniform::<FrameUniform>()
+                .push_constants::<BandPush>()
                 .specialize(0, tile_size)
                 .specialize(1, u32::from(off_axis))
                 .build(ctx)?;
@@ -39,8 +41,8 @@ impl ConvolvePass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
-        band_tiles: u32,
+        frame: FrameBlock<'_>,
+        band: &BandPush,
         psf: (&Image, &Sampler),
         field_table: &Buffer,
         fragments: &FragmentStore,
@@ -49,20 +51,22 @@ impl ConvolvePass {
         entries: &Buffer,
         output: &Image,
     ) -> GpuResult<()> {
+        let mut bindings = fragments.bind_with(
+            &[Binding::Sampled(psf.0, psf.1)],
+            &[
+                Binding::Buffer(counts),
+                Binding::Buffer(offsets),
+                Binding::Buffer(entries),
+                Binding::Storage(output),
+                Binding::Buffer(field_table),
+            ],
+        );
+        bindings.push(frame.binding());
         rec.dispatch(
             &self.pipeline,
-            &fragments.bind_with(
-                &[Binding::Sampled(psf.0, psf.1)],
-                &[
-                    Binding::Buffer(counts),
-                    Binding::Buffer(offsets),
-                    Binding::Buffer(entries),
-                    Binding::Storage(output),
-                    Binding::Buffer(field_table),
-                ],
-            ),
-            params,
-            per_tile_groups(band_tiles),
+            &bindings,
+            band,
+            per_tile_groups(band.tiles()),
         )
     }
 }

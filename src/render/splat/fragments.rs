@@ -5,7 +5,7 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
 };
 
-use super::{FrameParams, FRAGMENT_BYTES};
+use super::{FrameBlock, FrameUniform, FRAGMENT_BYTES};
 
 /// The frame's fragments: one buffer, bound to every pass as [`FRAGMENT_CHUNKS`] consecutive
 /// ranges (`FRAGMENT_BUFFERS` in glsl/common/splat.glsl). A 3840×2160 frame holds 380 MiB of
@@ -13,7 +13,7 @@ use super::{FrameParams, FRAGMENT_BYTES};
 /// ranges the device can bind instead of being refused.
 pub(super) struct FragmentStore {
     pub buffer: Buffer,
-    /// Fragments per range (the last may hold fewer); `FrameParams::fragments_per_chunk`.
+    /// Fragments per range (the last may hold fewer); `FrameUniform::fragments_per_chunk`.
     pub per_chunk: u32,
 }
 
@@ -97,8 +97,7 @@ pub(super) fn kinds_with_fragments(
     all
 }
 
-/// How hidden-layer fragments are judged (pass_u.x / pass_f.xy of glsl/render/splat/
-/// fragments.comp).
+/// How hidden-layer fragments are judged (`FragmentsPush`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct HiddenLight {
     /// Keep only the light of each hidden fragment that passes the nearer surfaces on its
@@ -108,6 +107,16 @@ pub(super) struct HiddenLight {
     pub focus_d: f32,
     /// Screen parallax (pixels) per dioptre for a ray through the pupil's edge: pupil
     /// radius (m) × focal length (pixels).
+    pub parallax_px_per_d: f32,
+}
+
+/// Push constants of the fragments pass. Mirrors `FragmentsPush` in
+/// glsl/render/splat/fragments.comp; see [`HiddenLight`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct FragmentsPush {
+    pub pupil_visibility: u32,
+    pub focus_d: f32,
     pub parallax_px_per_d: f32,
 }
 
@@ -127,7 +136,8 @@ impl FragmentsPass {
                     ],
                     &[BindingKind::StorageBuffer],
                 ))
-                .push_constants::<FrameParams>()
+                .uniform::<FrameUniform>()
+                .push_constants::<FragmentsPush>()
                 .build(ctx)?;
         Ok(FragmentsPass { pipeline })
     }
@@ -136,7 +146,7 @@ impl FragmentsPass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
+        frame: FrameBlock<'_>,
         color: &Image,
         depth: &Image,
         radii: &Buffer,
@@ -144,25 +154,25 @@ impl FragmentsPass {
         fragments: &FragmentStore,
         hidden: HiddenLight,
     ) -> GpuResult<()> {
-        let mut p = *params;
-        p.pass_u = [u32::from(hidden.pupil_visibility), 0, 0, 0];
-        p.pass_f = [hidden.focus_d, hidden.parallax_px_per_d, 0.0, 0.0];
+        let mut bindings = fragments.bind_with(
+            &[
+                Binding::Storage(color),
+                Binding::Storage(depth),
+                Binding::Buffer(radii),
+            ],
+            &[Binding::Buffer(field_table)],
+        );
+        bindings.push(frame.binding());
+        let p = frame.values;
         rec.dispatch(
             &self.pipeline,
-            &fragments.bind_with(
-                &[
-                    Binding::Storage(color),
-                    Binding::Storage(depth),
-                    Binding::Buffer(radii),
-                ],
-                &[Binding::Buffer(field_table)],
-            ),
-            &p,
-            [
-                params.width.div_ceil(8),
-                (params.height * params.layers).div_ceil(8),
-                1,
-            ],
+            &bindings,
+            &FragmentsPush {
+                pupil_visibility: u32::from(hidden.pupil_visibility),
+                focus_d: hidden.focus_d,
+                parallax_px_per_d: hidden.parallax_px_per_d,
+            },
+            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
 }

@@ -4,7 +4,15 @@
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
 use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::FrameParams;
+use super::{FrameBlock, FrameUniform};
+
+/// Push constants of one merge dispatch. Mirrors `MergePush` in glsl/render/splat/merge.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct MergePush {
+    /// Side of the blocks this dispatch makes: 2, then 4.
+    pub block_size: u32,
+}
 
 pub(super) struct MergePass {
     pipeline: ComputePipeline,
@@ -14,7 +22,8 @@ impl MergePass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("merge", crate::shaders::RENDER_SPLAT_MERGE_COMP)
             .bindings(&kinds_with_fragments(&[BindingKind::StorageBuffer], &[]))
-            .push_constants::<FrameParams>()
+            .uniform::<FrameUniform>()
+            .push_constants::<MergePush>()
             .build(ctx)?;
         Ok(MergePass { pipeline })
     }
@@ -23,20 +32,20 @@ impl MergePass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
+        frame: FrameBlock<'_>,
         levels: u32,
         radii: &Buffer,
         fragments: &FragmentStore,
     ) -> GpuResult<()> {
         for level in 1..=levels {
             let size = 1u32 << level;
-            let mut p = *params;
-            p.pass_u = [size, 0, 0, 0];
-            let blocks = [params.width / size, params.height / size];
+            let blocks = [frame.values.width / size, frame.values.height / size];
+            let mut bindings = fragments.bind_with(&[Binding::Buffer(radii)], &[]);
+            bindings.push(frame.binding());
             rec.dispatch(
                 &self.pipeline,
-                &fragments.bind_with(&[Binding::Buffer(radii)], &[]),
-                &p,
+                &bindings,
+                &MergePush { block_size: size },
                 [blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1],
             )?;
         }

@@ -8,9 +8,13 @@
 //!
 //! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`; `construct` builds a
 //! splatter, `settings` holds its options, `field` the off-axis lattice, `bands` the planning
-//! of tile-row bands.
+//! of tile-row bands, `uniform` the frame's uniform block. Values every dispatch of a frame
+//! shares are in that block (one persistent buffer, written through its mapping); values that
+//! change between dispatches are each pass's own typed push constants.
 
 mod bands;
+#[cfg(test)]
+mod block_layouts;
 mod construct;
 mod convolve;
 mod field;
@@ -23,17 +27,20 @@ mod settings;
 mod tile_count;
 mod tile_fill;
 mod tile_sort;
+mod uniform;
 
 use crate::gpu::{
     Buffer, Context, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings,
 };
 use crate::psf::kernels::KernelGrid;
-use crate::render::blend::BlendMode;
 
-use bands::plan_bands;
+use bands::{plan_bands, BandPush};
 pub use input::RecordedInput;
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
+use uniform::FrameBlock;
+pub(crate) use uniform::FrameUniform;
+pub use uniform::FRAME_UNIFORM_BYTES;
 
 /// Mirrors `struct Fragment` in glsl/common/splat.glsl (std430, 48 bytes).
 #[repr(C)]
@@ -47,41 +54,6 @@ pub struct Fragment {
     pub size: u32,
     /// Vergence along the pixel's ray (D, unclamped): the blend's grouping key.
     pub dioptre: f32,
-}
-
-/// Mirrors the push-constant block `FrameParams` in glsl/common/splat.glsl (128 bytes, the
-/// smallest push-constant size every Vulkan device offers).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct FrameParams {
-    pub width: u32,
-    pub height: u32,
-    pub tiles_x: u32,
-    pub tiles_y: u32,
-    pub tile_size: u32,
-    pub object_count: u32,
-    pub max_radius: u32,
-    pub fragment_count: u32,
-    pub dioptre_min: f32,
-    pub dioptre_step: f32,
-    pub merge_min_radius: f32,
-    pub merge_color_tolerance: f32,
-    pub merge_dioptre_tolerance: f32,
-    pub band_first_tile: u32,
-    pub band_end_tile: u32,
-    pub band_first_entry: u32,
-    pub focal_px: f32,
-    pub group_tolerance_d: f32,
-    pub blend_mode: u32,
-    pub wide_field: u32,
-    pub entry_capacity: u32,
-    pub saturation_epsilon: f32,
-    /// Fragments per bound range of the fragment buffer (`fragments::FragmentStore`).
-    pub fragments_per_chunk: u32,
-    /// Depth layers stacked in the inputs and the fragment buffer (1 = the visible surface).
-    pub layers: u32,
-    pub pass_u: [u32; 4],
-    pub pass_f: [f32; 4],
 }
 
 /// A colour + depth frame on the CPU: row-major, top row first.
@@ -178,6 +150,8 @@ struct FrameResources {
     cursors: Buffer,
     offsets: Buffer,
     block_sums: Buffer,
+    /// The frame's `FrameUniform`, written through its mapping before each submission.
+    uniform: Buffer,
     /// Persistent, mapped transfer buffers: host inputs in (made at the first host frame),
     /// the image and the list sizes out.
     staging: Option<input::Staging>,
@@ -317,6 +291,12 @@ impl Splatter {
                 tiles.div_ceil(1024) * 4,
                 Residency::Device,
             )?,
+            uniform: Buffer::new(
+                ctx,
+                "splat frame uniforms",
+                FRAME_UNIFORM_BYTES,
+                Residency::Upload,
+            )?,
             staging: None,
             readback_color: Buffer::new(
                 ctx,
@@ -334,41 +314,6 @@ impl Splatter {
         self.texture_blend = None;
         self.last_lists = None;
         Ok(())
-    }
-
-    fn params(&self, frame: &FrameResources) -> FrameParams {
-        let merge = &self.settings.merge;
-        FrameParams {
-            width: frame.width,
-            height: frame.height,
-            tiles_x: frame.tiles_x,
-            tiles_y: frame.tiles_y,
-            tile_size: self.settings.tile_size,
-            object_count: self.grid.objects.count as u32,
-            max_radius: self.grid.max_radius_px,
-            fragment_count: frame.width * frame.height * frame.layers,
-            dioptre_min: self.grid.objects.min_d as f32,
-            dioptre_step: self.grid.objects.step_d as f32,
-            merge_min_radius: merge.min_radius_px,
-            merge_color_tolerance: merge.color_tolerance,
-            merge_dioptre_tolerance: merge.dioptre_tolerance,
-            band_first_tile: 0,
-            band_end_tile: frame.tiles_x * frame.tiles_y,
-            band_first_entry: 0,
-            focal_px: 1.0,
-            group_tolerance_d: self.settings.blend.group_tolerance_d,
-            blend_mode: match self.settings.blend.mode {
-                BlendMode::Grouped => 0,
-                BlendMode::PerFragment => 1,
-            },
-            wide_field: u32::from(self.settings.blend.wide_field),
-            entry_capacity: 0,
-            saturation_epsilon: self.settings.saturation_epsilon,
-            fragments_per_chunk: frame.fragments.per_chunk,
-            layers: frame.layers,
-            pass_u: [0; 4],
-            pass_f: [0.0; 4],
-        }
     }
 
     /// Renders one frame through the eye's kernels for `view`.
@@ -427,16 +372,27 @@ impl Splatter {
         input::write_mapped_at(&mut self.radii_staging, 0, &radii);
         let table = self.field_table.contents(self.nodes(), &blend);
         input::write_mapped_at(&mut self.field_table.staging, 0, &table);
-        let upload_bytes = input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16;
         let projection = crate::render::projection::Projection {
             width: w,
             height: h,
             fov_y_deg: shape.fov_y_deg,
         };
+        let params = self.params(
+            self.frame.as_ref().expect("ensured above"),
+            projection.focal_px() as f32,
+        );
+        // Through the persistent mapping: submissions complete before `submit` returns, so no
+        // earlier frame still reads it.
+        let frame_mut = self.frame.as_mut().expect("ensured above");
+        input::write_mapped_at(&mut frame_mut.uniform, 0, std::slice::from_ref(&params));
+        let upload_bytes =
+            input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16 + FRAME_UNIFORM_BYTES;
         let frame = self.frame.as_ref().expect("ensured above");
-        let mut params = self.params(frame);
-        params.focal_px = projection.focal_px() as f32;
         let hidden = self.hidden_light(&params, &radii, view);
+        let block = FrameBlock {
+            values: &params,
+            buffer: &frame.uniform,
+        };
         let tiles = frame.tiles_x * frame.tiles_y;
         let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
         let output_bytes = pixels as u64 * 16;
@@ -452,11 +408,10 @@ impl Splatter {
         let mut sync = (0u32, 0u32);
         if one_submission {
             let entries = self.entries.as_ref().expect("checked above");
-            let mut p = params;
-            p.entry_capacity = entries_in(entries);
+            let band = BandPush::whole_frame(tiles, entries_in(entries));
             let timings = ctx.submit(|rec| {
                 let texture = rebuild_texture.then_some(&blend);
-                self.record_front(rec, &source, frame, &p, texture, hidden)?;
+                self.record_front(rec, &source, frame, block, texture, hidden)?;
                 rec.copy_buffer_region(
                     &frame.counts,
                     u64::from(tiles) * 4,
@@ -471,7 +426,7 @@ impl Splatter {
                     u64::from(2 * tiles + 1) * 4,
                     4,
                 );
-                self.record_band(rec, frame, &p, entries, tiles)?;
+                self.record_band(rec, frame, block, &band, entries)?;
                 rec.end_pass();
                 rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
                 sync = rec.barrier_counts();
@@ -480,7 +435,7 @@ impl Splatter {
             submissions += 1;
             let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
             let (live, total) = (sizes[tiles as usize], sizes[2 * tiles as usize + 1]);
-            if u64::from(total) <= u64::from(p.entry_capacity) {
+            if total <= band.entry_capacity {
                 self.texture_blend = Some(blend);
                 self.last_lists = Some((u64::from(total), 1));
                 let stats = SplatStats {
@@ -508,7 +463,7 @@ impl Splatter {
 
         // Planning frame: everything up to the exact list sizes, read back to plan bands.
         let mut timings = ctx.submit(|rec| {
-            self.record_front(rec, &source, frame, &params, Some(&blend), hidden)?;
+            self.record_front(rec, &source, frame, block, Some(&blend), hidden)?;
             rec.end_pass();
             rec.copy_buffer_region(
                 &frame.counts,
@@ -548,15 +503,20 @@ impl Splatter {
         let largest_band = bands.iter().map(|b| b.entries).max().unwrap_or(0);
         self.ensure_entries(largest_band)?;
         let frame = self.frame.as_ref().expect("ensured above");
+        let block = FrameBlock {
+            values: &params,
+            buffer: &frame.uniform,
+        };
         let entries = self.entries.as_ref().expect("ensured above");
         let band_timings = ctx.submit(|rec| {
             for band in &bands {
-                let mut p = params;
-                p.band_first_tile = band.first_tile;
-                p.band_end_tile = band.end_tile;
-                p.band_first_entry = band.first_entry;
-                p.entry_capacity = entries_in(entries);
-                self.record_band(rec, frame, &p, entries, band.end_tile - band.first_tile)?;
+                let push = BandPush {
+                    first_tile: band.first_tile,
+                    end_tile: band.end_tile,
+                    first_entry: band.first_entry,
+                    entry_capacity: entries_in(entries),
+                };
+                self.record_band(rec, frame, block, &push, entries)?;
             }
             rec.end_pass();
             rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
@@ -608,7 +568,7 @@ impl Splatter {
     /// vergence whose green kernel is smallest) and the parallax of the pupil's edge.
     fn hidden_light(
         &self,
-        params: &FrameParams,
+        params: &FrameUniform,
         radii: &[[f32; 4]],
         view: ViewState,
     ) -> fragments::HiddenLight {
@@ -625,14 +585,13 @@ impl Splatter {
     }
 
     /// Records the passes before the lists: inputs, PSF texture (given the blend when it
-    /// changed),
-    /// fragments, merging, tile counts and their prefix sum.
+    /// changed), fragments, merging, tile counts and their prefix sum.
     fn record_front(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         source: &input::Source<'_, '_>,
         frame: &FrameResources,
-        params: &FrameParams,
+        block: FrameBlock<'_>,
         rebuild_texture: Option<&crate::psf::kernels::GridBlend>,
         hidden: fragments::HiddenLight,
     ) -> crate::gpu::GpuResult<()> {
@@ -648,13 +607,13 @@ impl Splatter {
             for (node, resident) in self.resident.iter().enumerate() {
                 let tile = self.layout.tile_code(node);
                 self.psf_texture
-                    .record(rec, params, resident, blend, tile, &self.texture)?;
+                    .record(rec, block, resident, blend, tile, &self.texture)?;
             }
         }
         rec.begin_pass("fragments");
         self.fragments_pass.record(
             rec,
-            params,
+            block,
             &frame.color_in,
             &frame.depth_in,
             &self.radii,
@@ -666,7 +625,7 @@ impl Splatter {
             rec.begin_pass("merge");
             self.merge.record(
                 rec,
-                params,
+                block,
                 self.settings.merge.levels,
                 &self.radii,
                 &frame.fragments,
@@ -675,11 +634,10 @@ impl Splatter {
         rec.begin_pass("tile count");
         rec.fill_buffer(&frame.counts, 0);
         self.tile_count
-            .record(rec, params, &frame.fragments, &frame.counts)?;
+            .record(rec, block, &frame.fragments, &frame.counts)?;
         rec.begin_pass("prefix sum");
         self.prefix_sum.record(
             rec,
-            params,
             frame.tiles_x * frame.tiles_y,
             &frame.counts,
             &frame.offsets,
@@ -693,34 +651,29 @@ impl Splatter {
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         frame: &FrameResources,
-        params: &FrameParams,
+        block: FrameBlock<'_>,
+        band: &BandPush,
         entries: &Buffer,
-        band_tiles: u32,
     ) -> crate::gpu::GpuResult<()> {
         rec.begin_pass("tile fill");
         rec.fill_buffer(&frame.cursors, 0);
         self.tile_fill.record(
             rec,
-            params,
+            block,
+            band,
             &frame.fragments,
             &frame.offsets,
             &frame.cursors,
             entries,
         )?;
         rec.begin_pass("tile sort");
-        self.tile_sort.record(
-            rec,
-            params,
-            band_tiles,
-            &frame.counts,
-            &frame.offsets,
-            entries,
-        )?;
+        self.tile_sort
+            .record(rec, band, &frame.counts, &frame.offsets, entries)?;
         rec.begin_pass("convolve");
         self.convolve.record(
             rec,
-            params,
-            band_tiles,
+            block,
+            band,
             (&self.texture, &self.sampler),
             &self.field_table.buffer,
             &frame.fragments,

@@ -3,7 +3,16 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
-use super::FrameParams;
+/// Push constants of one prefix-sum dispatch. Mirrors `PrefixSumPush` in
+/// glsl/render/splat/prefix_sum.comp (the scan needs no frame values).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct PrefixSumPush {
+    /// 0: scan blocks of 1024; 1: scan the block totals; 2: add each block's base.
+    pub phase: u32,
+    /// Values scanned.
+    pub count: u32,
+}
 
 pub(super) struct PrefixSumPass {
     pipeline: ComputePipeline,
@@ -18,7 +27,7 @@ impl PrefixSumPass {
                     BindingKind::StorageBuffer,
                     BindingKind::StorageBuffer,
                 ])
-                .push_constants::<FrameParams>()
+                .push_constants::<PrefixSumPush>()
                 .build(ctx)?;
         Ok(PrefixSumPass { pipeline })
     }
@@ -27,7 +36,6 @@ impl PrefixSumPass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
         count: u32,
         counts: &Buffer,
         offsets: &Buffer,
@@ -40,9 +48,8 @@ impl PrefixSumPass {
             Binding::Buffer(block_sums),
         ];
         for (phase, groups) in [(0u32, blocks), (1, 1), (2, blocks)] {
-            let mut p = *params;
-            p.pass_u = [phase, count, 0, 0];
-            rec.dispatch(&self.pipeline, &bindings, &p, [groups, 1, 1])?;
+            let push = PrefixSumPush { phase, count };
+            rec.dispatch(&self.pipeline, &bindings, &push, [groups, 1, 1])?;
         }
         Ok(())
     }

@@ -7,7 +7,24 @@ use crate::gpu::{
 };
 use crate::psf::kernels::{level_count, texels_below_level, GridBlend, KernelGrid, KernelSet};
 
-use super::FrameParams;
+use super::{FrameBlock, FrameUniform};
+
+/// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node).
+/// Mirrors `PsfTexturePush` in glsl/render/splat/psf_texture.comp (std430: the vec4 sits at
+/// offset 16, right after the four uints).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(super) struct PsfTexturePush {
+    /// The chunk's radius levels [first_level, end_level).
+    pub first_level: u32,
+    pub end_level: u32,
+    /// Index of the chunk's first texel in a whole kernel set.
+    pub first_texel: u32,
+    /// The field node's tile: column | row << 10 | data offset << 20 (`field::TextureLayout`).
+    pub tile_code: u32,
+    /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
+    pub corner_weights: [f32; 4],
+}
 
 /// Texel format of the PSF texture: half floats halve memory and bandwidth; kernels are
 /// stored scaled by (2r+1)² so that half precision keeps about three significant digits.
@@ -135,7 +152,8 @@ impl PsfTexturePass {
                     BindingKind::StorageBuffer,
                     BindingKind::StorageImage,
                 ])
-                .push_constants::<FrameParams>()
+                .uniform::<FrameUniform>()
+                .push_constants::<PsfTexturePush>()
                 .build(ctx)?;
         Ok(PsfTexturePass { pipeline })
     }
@@ -143,14 +161,14 @@ impl PsfTexturePass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
+        frame: FrameBlock<'_>,
         grid: &ResidentGrid,
         blend: &GridBlend,
         tile_code: u32,
         texture: &Image,
     ) -> GpuResult<()> {
         // the tile's pitch: side + 2·margin (see glsl/render/splat/psf_texture.comp)
-        let side = 2 * params.max_radius + 1 + 2 * (tile_code >> 20);
+        let side = 2 * frame.values.max_radius + 1 + 2 * (tile_code >> 20);
         let chunks = grid.sets[blend.corners[0].0].len();
         for chunk in 0..chunks {
             // Unused corners repeat the first one with weight zero (never read).
@@ -158,15 +176,14 @@ impl PsfTexturePass {
                 |k: usize| &grid.sets[blend.corners.get(k).unwrap_or(&blend.corners[0]).0][chunk];
             let weight = |k: usize| blend.corners.get(k).map_or(0.0, |c| c.1 as f32);
             let first = corner(0);
-            let mut p = *params;
-            p.pass_u = [
-                first.first_level,
-                first.end_level,
-                first.first_texel,
+            let push = PsfTexturePush {
+                first_level: first.first_level,
+                end_level: first.end_level,
+                first_texel: first.first_texel,
                 tile_code,
-            ];
-            p.pass_f = [weight(0), weight(1), weight(2), weight(3)];
-            let layers = (first.end_level - first.first_level) * params.object_count;
+                corner_weights: [weight(0), weight(1), weight(2), weight(3)],
+            };
+            let layers = (first.end_level - first.first_level) * frame.values.object_count;
             rec.dispatch(
                 &self.pipeline,
                 &[
@@ -175,8 +192,9 @@ impl PsfTexturePass {
                     Binding::Buffer(&corner(2).buffer),
                     Binding::Buffer(&corner(3).buffer),
                     Binding::Storage(texture),
+                    frame.binding(),
                 ],
-                &p,
+                &push,
                 [side.div_ceil(8), side.div_ceil(8), layers],
             )?;
         }

@@ -4,7 +4,7 @@
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
 use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::FrameParams;
+use super::{FrameBlock, FrameUniform};
 
 pub(super) struct TileCountPass {
     pipeline: ComputePipeline,
@@ -15,7 +15,7 @@ impl TileCountPass {
         let pipeline =
             ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
                 .bindings(&kinds_with_fragments(&[], &[BindingKind::StorageBuffer]))
-                .push_constants::<FrameParams>()
+                .uniform::<FrameUniform>()
                 .build(ctx)?;
         Ok(TileCountPass { pipeline })
     }
@@ -24,19 +24,18 @@ impl TileCountPass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
+        frame: FrameBlock<'_>,
         fragments: &FragmentStore,
         counts: &Buffer,
     ) -> GpuResult<()> {
+        let mut bindings = fragments.bind_with(&[], &[Binding::Buffer(counts)]);
+        bindings.push(frame.binding());
+        let p = frame.values;
         rec.dispatch(
             &self.pipeline,
-            &fragments.bind_with(&[], &[Binding::Buffer(counts)]),
-            params,
-            [
-                params.width.div_ceil(8),
-                (params.height * params.layers).div_ceil(8),
-                1,
-            ],
+            &bindings,
+            &(),
+            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
 }

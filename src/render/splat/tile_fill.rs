@@ -3,8 +3,9 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
+use super::bands::BandPush;
 use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::FrameParams;
+use super::{FrameBlock, FrameUniform};
 
 pub(super) struct TileFillPass {
     pipeline: ComputePipeline,
@@ -22,37 +23,39 @@ impl TileFillPass {
                         BindingKind::StorageBuffer,
                     ],
                 ))
-                .push_constants::<FrameParams>()
+                .uniform::<FrameUniform>()
+                .push_constants::<BandPush>()
                 .build(ctx)?;
         Ok(TileFillPass { pipeline })
     }
 
     /// `cursors` must be zeroed; `entries` holds the band's lists.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
+        frame: FrameBlock<'_>,
+        band: &BandPush,
         fragments: &FragmentStore,
         offsets: &Buffer,
         cursors: &Buffer,
         entries: &Buffer,
     ) -> GpuResult<()> {
+        let mut bindings = fragments.bind_with(
+            &[],
+            &[
+                Binding::Buffer(offsets),
+                Binding::Buffer(cursors),
+                Binding::Buffer(entries),
+            ],
+        );
+        bindings.push(frame.binding());
+        let p = frame.values;
         rec.dispatch(
             &self.pipeline,
-            &fragments.bind_with(
-                &[],
-                &[
-                    Binding::Buffer(offsets),
-                    Binding::Buffer(cursors),
-                    Binding::Buffer(entries),
-                ],
-            ),
-            params,
-            [
-                params.width.div_ceil(8),
-                (params.height * params.layers).div_ceil(8),
-                1,
-            ],
+            &bindings,
+            band,
+            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
 }

@@ -3,8 +3,8 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
+use super::bands::BandPush;
 use super::tile_fill::per_tile_groups;
-use super::FrameParams;
 
 pub(super) struct TileSortPass {
     pipeline: ComputePipeline,
@@ -19,7 +19,7 @@ impl TileSortPass {
                     BindingKind::StorageBuffer,
                     BindingKind::StorageBuffer,
                 ])
-                .push_constants::<FrameParams>()
+                .push_constants::<BandPush>()
                 .build(ctx)?;
         Ok(TileSortPass { pipeline })
     }
@@ -27,8 +27,7 @@ impl TileSortPass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        params: &FrameParams,
-        band_tiles: u32,
+        band: &BandPush,
         counts: &Buffer,
         offsets: &Buffer,
         entries: &Buffer,
@@ -40,8 +39,8 @@ impl TileSortPass {
                 Binding::Buffer(offsets),
                 Binding::Buffer(entries),
             ],
-            params,
-            per_tile_groups(band_tiles),
+            band,
+            per_tile_groups(band.tiles()),
         )
     }
 }

@@ -1,0 +1,156 @@
+//! The Rust mirrors of the splat shaders' uniform and push-constant blocks against the
+//! compiled shaders (SPIR-V reflection; the build keeps debug names): every member's name and
+//! offset, and the block's size. Pipelines check sizes when they are built; this also catches
+//! two members swapped or renamed on one side only.
+
+use super::bands::BandPush;
+use super::fragments::FragmentsPush;
+use super::merge::MergePush;
+use super::prefix_sum::PrefixSumPush;
+use super::psf_texture::PsfTexturePush;
+use super::FrameUniform;
+use crate::gpu::{reflect, BlockLayout};
+
+/// The layout a `#[repr(C)]` struct gives the named fields, in the order given.
+macro_rules! layout_of {
+    ($t:ty { $($field:ident),* $(,)? }) => {
+        BlockLayout {
+            bytes: std::mem::size_of::<$t>() as u32,
+            members: vec![$((stringify!($field).to_string(), std::mem::offset_of!($t, $field) as u32)),*],
+        }
+    };
+}
+
+fn frame_uniform() -> BlockLayout {
+    layout_of!(FrameUniform {
+        width,
+        height,
+        tiles_x,
+        tiles_y,
+        tile_size,
+        object_count,
+        max_radius,
+        fragment_count,
+        dioptre_min,
+        dioptre_step,
+        merge_min_radius,
+        merge_color_tolerance,
+        merge_dioptre_tolerance,
+        focal_px,
+        group_tolerance_d,
+        blend_mode,
+        wide_field,
+        saturation_epsilon,
+        fragments_per_chunk,
+        layers,
+    })
+}
+
+fn band_push() -> BlockLayout {
+    layout_of!(BandPush {
+        first_tile,
+        end_tile,
+        first_entry,
+        entry_capacity
+    })
+}
+
+/// (shader, its frame block binding if it has one, its push-constant block if it has one)
+type ShaderBlocks = (
+    &'static str,
+    &'static [u8],
+    Option<u32>,
+    Option<BlockLayout>,
+);
+
+fn splat_shaders() -> Vec<ShaderBlocks> {
+    use crate::shaders::*;
+    vec![
+        (
+            "fragments",
+            RENDER_SPLAT_FRAGMENTS_COMP,
+            Some(8),
+            Some(layout_of!(FragmentsPush {
+                pupil_visibility,
+                focus_d,
+                parallax_px_per_d
+            })),
+        ),
+        (
+            "merge",
+            RENDER_SPLAT_MERGE_COMP,
+            Some(5),
+            Some(layout_of!(MergePush { block_size })),
+        ),
+        ("tile count", RENDER_SPLAT_TILE_COUNT_COMP, Some(5), None),
+        (
+            "prefix sum",
+            RENDER_SPLAT_PREFIX_SUM_COMP,
+            None,
+            Some(layout_of!(PrefixSumPush { phase, count })),
+        ),
+        (
+            "psf texture",
+            RENDER_SPLAT_PSF_TEXTURE_COMP,
+            Some(5),
+            Some(layout_of!(PsfTexturePush {
+                first_level,
+                end_level,
+                first_texel,
+                tile_code,
+                corner_weights
+            })),
+        ),
+        (
+            "tile fill",
+            RENDER_SPLAT_TILE_FILL_COMP,
+            Some(7),
+            Some(band_push()),
+        ),
+        (
+            "tile sort",
+            RENDER_SPLAT_TILE_SORT_COMP,
+            None,
+            Some(band_push()),
+        ),
+        (
+            "convolve",
+            RENDER_SPLAT_CONVOLVE_COMP,
+            Some(10),
+            Some(band_push()),
+        ),
+    ]
+}
+
+#[test]
+fn shader_blocks_match_their_rust_structs_member_by_member() {
+    for (name, spirv, frame_binding, push) in splat_shaders() {
+        let r = reflect(spirv).unwrap();
+        let uniforms: Vec<_> = r.bindings.iter().filter(|b| b.block.is_some()).collect();
+        match frame_binding {
+            Some(binding) => {
+                assert_eq!(uniforms.len(), 1, "{name}: one uniform block");
+                assert_eq!(uniforms[0].binding, binding, "{name}: frame block binding");
+                // the frame block is each pass's last binding (the Rust side appends it)
+                assert_eq!(r.bindings.last().unwrap().binding, binding, "{name}");
+                assert_eq!(uniforms[0].block.as_ref(), Some(&frame_uniform()), "{name}");
+            }
+            None => assert!(uniforms.is_empty(), "{name}: no frame block"),
+        }
+        assert_eq!(r.push_constants, push, "{name}: push constants");
+    }
+}
+
+/// Negative control: the comparison sees a swap of two same-typed members, which a size
+/// check cannot.
+#[test]
+fn a_swapped_member_is_seen() {
+    let mut swapped = band_push();
+    swapped.members.swap(0, 1);
+    let (a, b) = (swapped.members[0].1, swapped.members[1].1);
+    swapped.members[0].1 = b;
+    swapped.members[1].1 = a;
+    let r = reflect(crate::shaders::RENDER_SPLAT_TILE_SORT_COMP).unwrap();
+    assert_eq!(r.push_constants.as_ref().map(|p| p.bytes), Some(16));
+    assert_ne!(r.push_constants, Some(swapped));
+}
