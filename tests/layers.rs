@@ -283,3 +283,64 @@ fn what_the_floor_buries_stays_hidden() {
         "control: {leaked} on a floor of {floor}"
     );
 }
+
+/// A black wall at 2 m with a bright vertical stripe on it just behind the right edge of a
+/// card at 0.25 m (`card`: whether the card is there).
+fn stripe_scene(card: bool) -> Scene {
+    let px_m = WALL_M / focal_px();
+    let mut text = format!(
+        "[camera]\nposition = [0.0, 0.0, 0.0]\nfov_y_deg = {FOV}\nfar_m = 100.0\n\n\
+         [[object]]\nkind = \"plane\"\nsize_m = 3.0\ntranslate = [0.0, 0.0, {}]\n\
+         color = [0.0, 0.0, 0.0]\n\n\
+         [[object]]\nkind = \"plane\"\nsize_m = [{}, 2.0]\ntranslate = [{}, 0.0, {}]\n\
+         color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 100.0\n",
+        -WALL_M,
+        2.0 * px_m,
+        -3.0 * px_m,
+        -WALL_M + 0.001
+    );
+    if card {
+        text += &format!(
+            "\n[[object]]\nkind = \"plane\"\nsize_m = 1.0\ntranslate = [-0.5, 0.0, {}]\n\
+             color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 40.0\n",
+            -CARD_M
+        );
+    }
+    Scene::from_toml(&text, "stripe behind a card", Path::new(".")).unwrap()
+}
+
+#[test]
+fn a_blurred_hidden_stripe_lands_outside_a_sharp_cards_edge() {
+    // Focused on the card: the wall blurs by 10.5 px. A ray from the stripe (2–4 px behind
+    // the card's edge) to the pupil misses the card exactly when it lands outside the card's
+    // sharp edge (the parallax and the blur share the scale a·f), so beyond the edge the eye
+    // sees what it would see with no card at all. (A point farther than the focus lands on
+    // the side of its pupil point, so the rays that pass the edge are those that land past
+    // it; with the orientation mirrored this light would fall under the card instead.)
+    let focus_d = 1.0 / CARD_M;
+    let bare = splat_focused(&layers(&stripe_scene(false), 1), focus_d, true);
+    let frames = layers(&stripe_scene(true), 2);
+    let one = splat_focused(&frames[..1], focus_d, true);
+    let two = splat_focused(&frames, focus_d, true);
+    let edge = W as usize / 2;
+    let light = |img: &[[f32; 4]]| -> f64 {
+        (20..70)
+            .flat_map(|y| (edge + 1..edge + 11).map(move |x| (x, y)))
+            .map(|(x, y)| f64::from(img[y * W as usize + x][1]))
+            .sum()
+    };
+    let (l_bare, l_one, l_two) = (light(&bare), light(&one), light(&two));
+    eprintln!(
+        "stripe light past the card's edge: no card {l_bare:.1}, one layer {l_one:.1}, two layers {l_two:.1}"
+    );
+    assert!(
+        l_bare > 100.0,
+        "the stripe's blur reaches past the edge: {l_bare}"
+    );
+    assert!(
+        (l_two - l_bare).abs() < 0.2 * l_bare,
+        "two layers: {l_two} against {l_bare} with no card"
+    );
+    // Negative control: one layer knows nothing of the stripe.
+    assert!(l_one < 0.02 * l_bare, "one layer: {l_one}");
+}
