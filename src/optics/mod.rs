@@ -1,6 +1,7 @@
 //! Pure optics numerics: no I/O, no GPU.
 //!
 //! - [`zernike`]: OSA/ANSI Zernike algebra (std only; compiled on its own by the eye model).
+//! - [`prescription`]: sphere / cylinder / axis and its second-order Zernike terms.
 //! - [`bessel`]: J_n and spherical j_k by Miller recurrence.
 //! - [`quadrature`]: Gauss–Legendre, Fejér (cosine-sampled pupil) rules, a small FFT.
 //! - [`enz`]: V_n^m(r, f) (Bessel–Bessel series, power series, quadrature) and radial tables.
@@ -13,6 +14,7 @@ pub mod beta;
 pub mod enz;
 pub mod fft_psf;
 pub mod field;
+pub mod prescription;
 pub mod psf;
 pub mod pupil;
 pub mod quadrature;
