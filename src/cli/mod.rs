@@ -23,6 +23,7 @@ mod render;
 mod render_output;
 mod sha256;
 mod video;
+mod video_files;
 mod video_frame;
 mod video_manifest;
 
