@@ -342,6 +342,74 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
     assert!(report["device"].as_str().is_some_and(|d| !d.is_empty()));
 }
 
+/// A peeled scene (`--layers 2`) stays on the GPU in bench and render: bench's steady frame
+/// is one submission, no allocation, no pixel up and only the image down, where its baseline
+/// (every layer read back, its depth uploaded for the next peel, the layers uploaded to
+/// splat) moves every layer both ways; render draws the layers in splat's submission (its
+/// passes have the raster and the input pass, no upload).
+#[test]
+fn peeled_layers_stay_on_the_gpu_in_bench_and_render() {
+    let dir = temp_dir("layers");
+    let json = dir.join("bench.json");
+    run_ok(
+        ocular()
+            .args([
+                "bench",
+                "--size",
+                "160x90",
+                "--eye",
+                "navarro",
+                "--layers",
+                "2",
+                "--warmup",
+                "1",
+                "--frames",
+                "2",
+                "--baseline",
+                "--cache",
+            ])
+            .arg(cache())
+            .arg("--json")
+            .arg(&json),
+    );
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(report["layers"], 2);
+    let (c, old) = (&report["counters"], &report["baseline"]["counters"]);
+    let layer_bytes = 2 * 160 * 90 * 20;
+    assert_eq!(c["submissions"], 1, "{c}");
+    assert_eq!(c["allocations"], 0, "{c}");
+    assert!(c["upload_bytes"].as_u64().unwrap() < 4096, "{c}");
+    assert_eq!(c["readback_bytes"], 160 * 90 * 16 + 8, "{c}");
+    assert!(old["upload_bytes"].as_u64().unwrap() > layer_bytes, "{old}");
+    assert!(
+        old["readback_bytes"].as_u64().unwrap() > layer_bytes,
+        "{old}"
+    );
+    assert!(old["submissions"].as_u64().unwrap() >= 4, "{old}");
+
+    let summary: serde_json::Value = serde_json::from_str(&run_ok(
+        ocular()
+            .args([
+                "render", "--size", "160x90", "--eye", "navarro", "--layers", "2", "--json",
+                "--cache",
+            ])
+            .arg(cache())
+            .arg("-o")
+            .arg(dir.join("layers.png")),
+    ))
+    .unwrap();
+    let passes: Vec<&str> = summary["gpu_ms"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p[0].as_str().unwrap())
+        .collect();
+    assert!(
+        passes.contains(&"raster") && passes.contains(&"input") && !passes.contains(&"upload"),
+        "{passes:?}"
+    );
+}
+
 #[test]
 fn compare_reports_quality_and_writes_maps() {
     let dir = temp_dir("compare");

@@ -41,6 +41,10 @@ pub struct BenchArgs {
     /// Timed frames.
     #[arg(long, default_value_t = 100)]
     pub frames: usize,
+    /// Depth layers splat takes (1–8; default 1): the scene is depth-peeled to K layers, each
+    /// drawn in splat's own submission, so the per-layer cost shows in the passes.
+    #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
+    pub layers: Option<u32>,
     /// Pupil diameter (default: the scene's, else 5 mm as in the seed paper's tests).
     #[arg(long, value_name = "MM")]
     pub pupil_mm: Option<f64>,
@@ -112,6 +116,8 @@ struct Report {
     eye: String,
     width: u32,
     height: u32,
+    /// Depth layers splat took (1: the visible surface).
+    layers: u32,
     warmup: usize,
     frames: usize,
     focus_d: f64,
@@ -168,6 +174,9 @@ struct SceneInput<'a, 's> {
     raster: &'a mut Rasterizer,
     state: &'a FrameState<'s>,
     size: (u32, u32),
+    /// Depth layers and the peeling gap (dioptres).
+    layers: u32,
+    gap_d: f32,
 }
 
 impl SceneInput<'_, '_> {
@@ -181,29 +190,53 @@ impl SceneInput<'_, '_> {
         resident: bool,
     ) -> Result<crate::render::frame::RenderedFrame> {
         if resident {
-            let mut frame = self.raster.scene_frame(self.ctx, self.state, self.size);
+            let mut frame = self
+                .raster
+                .scene_frame(self.ctx, self.state, self.size)
+                .peeled(self.layers, self.gap_d);
             return renderer.render_recorded(&mut frame, eye);
         }
         let (width, height) = self.size;
-        let frame = self.raster.render(self.ctx, self.state, width, height)?;
+        let frames =
+            self.raster
+                .render_layers(self.ctx, self.state, self.size, self.layers, self.gap_d)?;
+        let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = frames[1..]
+            .iter()
+            .map(|f| crate::render::splat::HiddenLayer {
+                color: &f.color,
+                depth_m: &f.depth_m,
+            })
+            .collect();
         let input = FrameInput {
             width,
             height,
-            color: &frame.color,
-            depth_m: &frame.depth_m,
+            color: &frames[0].color,
+            depth_m: &frames[0].depth_m,
             fov_y_deg: self.state.camera.fov_y_deg,
-            hidden_layers: &[],
+            hidden_layers: &hidden,
         };
         let mut out = renderer.render(&input, eye, Method::Splat)?;
-        let mut timings = frame.timings;
+        // a pass drawn once per layer counts once per frame, its times summed
+        let mut timings = crate::gpu::Timings::default();
+        for pass in frames.iter().flat_map(|f| &f.timings.passes) {
+            match timings.passes.iter_mut().find(|p| p.name == pass.name) {
+                Some(p) => p.ms += pass.ms,
+                None => timings.passes.push(pass.clone()),
+            }
+        }
         if let Some(t) = out.timings.take() {
             timings.extend(t);
         }
         out.timings = Some(timings);
         if let Some(s) = &mut out.stats {
-            s.submissions += 1;
-            s.upload_bytes += crate::render::raster::FRAME_UNIFORM_BYTES;
-            s.readback_bytes += u64::from(width) * u64::from(height) * 20;
+            // per layer: its draw and read-back; per later layer: the previous layer's depth
+            // uploaded (a submission of its own)
+            let layers = u64::from(self.layers);
+            let pixels = u64::from(width) * u64::from(height);
+            s.submissions += (2 * layers - 1) as u32;
+            s.upload_bytes +=
+                layers * crate::render::raster::FRAME_UNIFORM_BYTES + (layers - 1) * pixels * 4;
+            s.readback_bytes += layers * pixels * 20;
         }
         Ok(out)
     }
@@ -303,6 +336,12 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let max_radius_px = kernels.grid.max_radius_px;
     let field = kernels.field.as_ref().map(|f| f.plan.axes.clone());
     let baseline_inputs = args.baseline.then(|| (eye.clone(), kernels.clone()));
+    let mut notes = Vec::new();
+    let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
+    for n in &notes {
+        println!("note: {n}");
+    }
+    let gap_d = splat.blend.group_tolerance_d;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = FrameInput {
         width,
@@ -322,6 +361,8 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         raster: &mut raster,
         state: &scene_state,
         size: args.size,
+        layers,
+        gap_d,
     };
     let timed = time_frames(&mut renderer, &mut scene_input, true, eye_state, args, &bar)?;
     let baseline = if let Some((eye, kernels)) = baseline_inputs {
@@ -391,6 +432,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         eye: args.eye.clone(),
         width,
         height,
+        layers,
         warmup: args.warmup,
         frames: args.frames,
         focus_d,
@@ -441,8 +483,8 @@ fn print_table(r: &Report) {
         r.scene, r.eye, r.width, r.height, r.device, r.driver
     );
     println!(
-        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} list entries/frame",
-        r.focus_d, r.pupil_mm, r.max_radius_px, r.list_entries
+        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} depth layer(s), {} list entries/frame",
+        r.focus_d, r.pupil_mm, r.max_radius_px, r.layers, r.list_entries
     );
     if let Some(f) = &r.field {
         println!(

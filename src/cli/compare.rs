@@ -248,17 +248,6 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     for n in &notes {
         println!("note: {n}");
     }
-    let peeled = if layers > 1 {
-        crate::render::Rasterizer::new(&ctx)?.render_layers(
-            &ctx,
-            &scene.at_time(0.0),
-            args.size,
-            layers,
-            splat.blend.group_tolerance_d,
-        )?
-    } else {
-        Vec::new()
-    };
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     renderer.slice_count = args.slices;
     let input = FrameInput {
@@ -333,20 +322,20 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     // The first splat frame compiles shaders and uploads the kernels: time the second.
     renderer.render(&input, eye_state, Method::Splat)?;
     let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
-    let layered_frame = if peeled.len() > 1 {
-        let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = peeled[1..]
-            .iter()
-            .map(|f| crate::render::splat::HiddenLayer {
-                color: &f.color,
-                depth_m: &f.depth_m,
-            })
-            .collect();
-        let layered = FrameInput {
-            hidden_layers: &hidden,
-            ..input
+    // The layered frame is peeled and splatted in one submission, its layers never on the
+    // host (tests/engine.rs: the same image as the layers read back and uploaded).
+    let layered_frame = if layers > 1 {
+        let state = scene.at_time(0.0);
+        let mut raster = crate::render::Rasterizer::new(&ctx)?;
+        let gap_d = splat.blend.group_tolerance_d;
+        let mut layered = || {
+            let mut recorded = raster
+                .scene_frame(&ctx, &state, args.size)
+                .peeled(layers, gap_d);
+            renderer.render_recorded(&mut recorded, eye_state)
         };
-        renderer.render(&layered, eye_state, Method::Splat)?;
-        Some(renderer.render(&layered, eye_state, Method::Splat)?)
+        layered()?;
+        Some(layered()?)
     } else {
         None
     };
@@ -398,9 +387,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         Some((&truth, truth_method.name(), 1)),
         reference_frame.as_ref().map(|f| (f, "reference", 1)),
         Some((&splat_frame, "splat", 1)),
-        layered_frame
-            .as_ref()
-            .map(|f| (f, "splat-layers", peeled.len() as u32)),
+        layered_frame.as_ref().map(|f| (f, "splat-layers", layers)),
         slices_frame.as_ref().map(|f| (f, "slices", 1)),
     ]
     .into_iter()

@@ -235,9 +235,10 @@ pub(super) struct Input {
     pub(super) depth_source: Option<String>,
     pub(super) depth_report: Option<crate::inputs::DepthReport>,
     pub(super) warnings: Vec<String>,
-    /// A scene drawn as one layer: its rasteriser and scene, so that splat draws the frame
-    /// again inside its own submission instead of uploading these pixels.
-    pub(super) raster: Option<(Rasterizer, Scene)>,
+    /// A scene: its rasteriser, the scene and the depth layers splat takes, so that splat
+    /// draws the frame (every layer) again inside its own submission instead of uploading
+    /// pixels.
+    pub(super) raster: Option<(Rasterizer, Scene, u32)>,
 }
 
 fn load_input(
@@ -319,17 +320,9 @@ fn load_input(
     } else {
         1
     };
-    let mut frames = rasterizer
-        .render_layers(
-            ctx,
-            &state,
-            (width, height),
-            k,
-            args.splat.blend.settings().group_tolerance_d,
-        )?
-        .into_iter();
-    let frame = frames.next().expect("layer 0");
-    let hidden = frames.map(|f| (f.color, f.depth_m)).collect();
+    // Layer 0 comes to the host for the depth range, the near-clamp report and the other
+    // methods; splat draws every layer again in its own submission (peeled there too).
+    let frame = rasterizer.render(ctx, &state, width, height)?;
     let mut depth_m = frame.depth_m;
     let near = crate::render::focus::nearest_supported_m();
     let clamped = depth_m
@@ -357,8 +350,8 @@ fn load_input(
         pupil_mm,
         luminance_cdm2,
         label: format!("scene {name}"),
-        raster: (k == 1).then_some((rasterizer, scene)),
-        hidden,
+        raster: Some((rasterizer, scene, k)),
+        hidden: Vec::new(),
         depth_source: None,
         depth_report: None,
         warnings,
@@ -635,10 +628,13 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     let frame = match &mut input.raster {
         // the frame stays on the GPU: drawn again in splat's submission, not uploaded
-        Some((rasterizer, scene)) if args.method == Method::Splat => {
+        Some((rasterizer, scene, layers)) if args.method == Method::Splat => {
             let scene_state = scene.at_time(args.time);
             let size = (input.width, input.height);
-            let mut recorded = rasterizer.scene_frame(&ctx, &scene_state, size);
+            let gap_d = args.splat.blend.settings().group_tolerance_d;
+            let mut recorded = rasterizer
+                .scene_frame(&ctx, &scene_state, size)
+                .peeled(*layers, gap_d);
             renderer.render_recorded(&mut recorded, state)?
         }
         _ => renderer.render(&frame_input, state, args.method)?,

@@ -320,13 +320,17 @@ impl Rasterizer {
             &[&color],
             Some(&depth_ms),
         )?;
+        // storage: where peeled layers stay on the GPU, splat's input pass writes it
         let previous_depth = Image::new_2d(
             ctx,
             "raster previous layer depth",
             width,
             height,
             TexelFormat::R32Float,
-            ImageUsage::SAMPLED,
+            ImageUsage {
+                storage: true,
+                ..ImageUsage::SAMPLED
+            },
         )?;
         let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
@@ -651,12 +655,15 @@ impl Rasterizer {
     }
 
     /// Prepares `state`'s frame, seen by its own camera at `width`×`height`, for recording
-    /// into another submission; returns the bytes it wrote for the device.
+    /// into another submission (with the peeling gap where layers follow: the raster shader
+    /// ignores it, so layer 0 is the same either way); returns the bytes it wrote for the
+    /// device.
     pub(crate) fn prepare_camera_frame(
         &mut self,
         ctx: &Context,
         state: &FrameState<'_>,
         (width, height): (u32, u32),
+        peel_gap_d: Option<f32>,
     ) -> Result<u64> {
         let camera = &state.camera;
         let aspect = f64::from(width) / f64::from(height);
@@ -667,19 +674,26 @@ impl Rasterizer {
             (width, height),
             view_proj,
             camera.position_m,
-            None,
+            peel_gap_d,
         )?;
         Ok(FRAME_UNIFORM_BYTES)
     }
 
-    /// Records the prepared frame; returns where it leaves the colour and the depth.
+    /// Records the prepared frame's draw, or with `peel` the next layer's (behind the depth
+    /// in `previous_depth`, which the caller wrote); returns where it leaves the layer.
     pub(crate) fn record_frame(
         &self,
         rec: &mut Recorder<'_>,
         state: &FrameState<'_>,
-    ) -> crate::gpu::GpuResult<(&Image, &Buffer)> {
-        self.record(rec, state, false)?;
+        peel: bool,
+    ) -> crate::gpu::GpuResult<crate::render::splat::RecordedLayer<'_>> {
+        self.record(rec, state, peel)?;
         let targets = self.targets.as_ref().expect("prepared");
-        Ok((&targets.color, &targets.depth))
+        Ok(crate::render::splat::RecordedLayer {
+            color: &targets.color,
+            depth_m: &targets.depth,
+            far_m: state.camera.far_m as f32,
+            previous_depth: &targets.previous_depth,
+        })
     }
 }

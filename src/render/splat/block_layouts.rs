@@ -5,6 +5,7 @@
 
 use super::bands::BandPush;
 use super::fragments::FragmentsPush;
+use super::input::InputPush;
 use super::merge::MergePush;
 use super::prefix_sum::PrefixSumPush;
 use super::psf_texture::PsfTexturePush;
@@ -66,6 +67,19 @@ type ShaderBlocks = (
 fn splat_shaders() -> Vec<ShaderBlocks> {
     use crate::shaders::*;
     vec![
+        (
+            "input",
+            RENDER_SPLAT_INPUT_COMP,
+            None,
+            Some(layout_of!(InputPush {
+                width,
+                height,
+                layer,
+                write_previous,
+                near_m,
+                far_m
+            })),
+        ),
         (
             "fragments",
             RENDER_SPLAT_FRAGMENTS_COMP,

@@ -2,7 +2,9 @@
 //! written into persistent mapped staging buffers and copied into splat's input images; a
 //! frame the GPU makes itself (a rasterised scene, [`RecordedInput`]) is recorded into splat's
 //! own submission and taken into the input images by the input pass (glsl/render/splat/
-//! input.comp), so its pixels never cross to the host. Both feed the same passes after this.
+//! input.comp), so its pixels never cross to the host. A peeled frame is recorded layer by
+//! layer, each draw followed by the input pass that stacks it under the earlier ones and
+//! hands its depth to the next peel on the GPU. Both feed the same passes after this.
 
 use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
@@ -11,19 +13,41 @@ use crate::{Error, Result};
 
 use super::{FrameInput, FrameResources};
 
-/// A frame made on the GPU inside splat's submission.
+/// A frame made on the GPU inside splat's submission, as one or more depth layers.
 pub trait RecordedInput {
     /// Width and height in pixels.
     fn size(&self) -> (u32, u32);
+    /// Depth layers the frame has: 1, the visible surface, unless the frame is peeled.
+    fn layers(&self) -> u32 {
+        1
+    }
     /// Vertical field of view of the pinhole camera that makes the frame (degrees).
     fn fov_y_deg(&self) -> f64;
     /// Host-side work before recording (uploads, uniforms through their mapping); returns the
     /// bytes it wrote for the device.
     fn prepare(&mut self) -> Result<u64>;
-    /// Records the commands that make the frame and returns where they leave it: linear RGB
-    /// in an RGBA32F image with storage usage, and the distance along the view axis in metres
-    /// as one f32 per pixel, row-major, in a buffer.
-    fn record<'a>(&'a self, rec: &mut Recorder<'_>) -> GpuResult<(&'a Image, &'a Buffer)>;
+    /// Records the commands that make layer `layer` (0: the visible surface; layer k is
+    /// recorded after the input pass took layer k − 1, whose depth it may read from that
+    /// layer's [`RecordedLayer::previous_depth`]) and returns where they leave it.
+    fn record_layer<'a>(
+        &'a self,
+        rec: &mut Recorder<'_>,
+        layer: u32,
+    ) -> GpuResult<RecordedLayer<'a>>;
+}
+
+/// Where a recorded layer's commands leave it.
+pub struct RecordedLayer<'a> {
+    /// Linear RGB in an RGBA32F image with storage usage; in a hidden layer, premultiplied by
+    /// the coverage in alpha.
+    pub color: &'a Image,
+    /// The distance along the view axis in metres, one f32 per pixel, row-major.
+    pub depth_m: &'a Buffer,
+    /// Distance at and beyond which a pixel shows no surface (the far plane, metres).
+    pub far_m: f32,
+    /// An R32F storage image the next layer's draw reads this layer's depth from (the far
+    /// plane as +∞); written by the input pass only where another layer follows.
+    pub previous_depth: &'a Image,
 }
 
 pub(super) enum Source<'i, 'f> {
@@ -47,10 +71,15 @@ pub(super) struct Staging {
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct InputPush {
-    width: u32,
-    height: u32,
-    near_m: f32,
+pub(super) struct InputPush {
+    pub width: u32,
+    pub height: u32,
+    /// Which layer of the stack this dispatch writes (its rows start at layer · height).
+    pub layer: u32,
+    /// 1 where another layer follows and reads this one's depth.
+    pub write_previous: u32,
+    pub near_m: f32,
+    pub far_m: f32,
 }
 
 pub(super) struct InputPass {
@@ -63,6 +92,7 @@ impl InputPass {
             .bindings(&[
                 BindingKind::StorageImage,
                 BindingKind::StorageBuffer,
+                BindingKind::StorageImage,
                 BindingKind::StorageImage,
                 BindingKind::StorageImage,
             ])
@@ -81,7 +111,7 @@ impl Source<'_, '_> {
                 Shape {
                     width,
                     height,
-                    layers: 1,
+                    layers: frame.layers(),
                     fov_y_deg: frame.fov_y_deg(),
                 }
             }
@@ -115,6 +145,9 @@ impl Source<'_, '_> {
                 }
             }
         };
+        if shape.layers == 0 {
+            return Err(Error::input("a frame needs at least one depth layer"));
+        }
         if shape.width == 0 || shape.height == 0 {
             return Err(Error::input(format!(
                 "frame size {}×{} has no pixels",
@@ -169,23 +202,31 @@ impl Source<'_, '_> {
                 Ok(())
             }
             Source::Gpu(recorded) => {
-                let (color, depth) = recorded.record(rec)?;
-                rec.begin_pass("input");
-                rec.dispatch(
-                    &pass.pipeline,
-                    &[
-                        Binding::Storage(color),
-                        Binding::Buffer(depth),
-                        Binding::Storage(&frame.color_in),
-                        Binding::Storage(&frame.depth_in),
-                    ],
-                    &InputPush {
-                        width: frame.width,
-                        height: frame.height,
-                        near_m: crate::render::focus::nearest_supported_m(),
-                    },
-                    [frame.width.div_ceil(8), frame.height.div_ceil(8), 1],
-                )
+                let layers = recorded.layers();
+                for layer in 0..layers {
+                    let out = recorded.record_layer(rec, layer)?;
+                    rec.begin_pass("input");
+                    rec.dispatch(
+                        &pass.pipeline,
+                        &[
+                            Binding::Storage(out.color),
+                            Binding::Buffer(out.depth_m),
+                            Binding::Storage(&frame.color_in),
+                            Binding::Storage(&frame.depth_in),
+                            Binding::Storage(out.previous_depth),
+                        ],
+                        &InputPush {
+                            width: frame.width,
+                            height: frame.height,
+                            layer,
+                            write_previous: u32::from(layer + 1 < layers),
+                            near_m: crate::render::focus::nearest_supported_m(),
+                            far_m: out.far_m,
+                        },
+                        [frame.width.div_ceil(8), frame.height.div_ceil(8), 1],
+                    )?;
+                }
+                Ok(())
             }
         }
     }

@@ -35,7 +35,7 @@ use crate::gpu::{
 use crate::psf::kernels::KernelGrid;
 
 use bands::{plan_bands, BandPush};
-pub use input::RecordedInput;
+pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
 use uniform::FrameBlock;
