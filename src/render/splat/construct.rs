@@ -1,11 +1,14 @@
 //! Building a splatter: the kernels resident on the GPU (on axis one grid, off axis one per
-//! field node), the PSF texture's layout, and every pass.
+//! field node), the PSF texture's layout, every pass, and the per-frame resources.
 
 use super::{
-    convolve, field, fragments, input, merge, prefix_sum, psf_texture, tile_count, tile_fill,
-    tile_sort, PsfTextureFormat, SplatSettings, Splatter, MAX_OFF_AXIS_TILE,
+    binding_limit, convolve, field, fragments, input, merge, prefix_sum, psf_texture, tile_count,
+    tile_fill, tile_sort, FrameResources, PsfTextureFormat, SplatSettings, Splatter,
+    FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
 };
-use crate::gpu::{Buffer, Context, Edge, GpuError, Residency, Sampler};
+use crate::gpu::{
+    Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat,
+};
 use crate::psf::kernels::KernelGrid;
 
 impl Splatter {
@@ -140,6 +143,104 @@ impl Splatter {
     }
 
     /// The field lattice of off-axis kernels (None on axis).
+    /// Per-frame resources for `width`×`height` with `layers` depth layers, made when the
+    /// size or layer count changes and kept otherwise.
+    pub(super) fn ensure_frame(
+        &mut self,
+        width: u32,
+        height: u32,
+        layers: u32,
+    ) -> crate::Result<()> {
+        if self
+            .frame
+            .as_ref()
+            .is_some_and(|f| f.width == width && f.height == height && f.layers == layers)
+        {
+            return Ok(());
+        }
+        let ctx = &self.ctx;
+        // every layer's pixels: the inputs and fragments are stacked layer under layer
+        let pixels = u64::from(width) * u64::from(height) * u64::from(layers);
+        let limit = binding_limit(ctx).min(self.settings.max_fragment_binding_bytes);
+        let Some(per_chunk) = fragments::fragments_per_chunk(pixels, limit) else {
+            return Err(crate::Error::input(format!(
+                "a {width}×{height} frame with {layers} depth layer(s) needs {} MiB of fragments, over \
+                 four of this device's {} MiB storage-buffer bindings; render at most {} pixels (all \
+                 layers) per frame on this device",
+                (pixels * FRAGMENT_BYTES) >> 20,
+                limit >> 20,
+                fragments::FRAGMENT_CHUNKS * (limit / FRAGMENT_BYTES)
+            )));
+        };
+        let tile = self.settings.tile_size;
+        let (tiles_x, tiles_y) = (width.div_ceil(tile), height.div_ceil(tile));
+        let tiles = u64::from(tiles_x) * u64::from(tiles_y);
+        let storage = ImageUsage::STORAGE;
+        self.frame = Some(FrameResources {
+            width,
+            height,
+            layers,
+            tiles_x,
+            tiles_y,
+            color_in: Image::new_2d(
+                ctx,
+                "input colour",
+                width,
+                height * layers,
+                TexelFormat::Rgba32Float,
+                storage,
+            )?,
+            depth_in: Image::new_2d(
+                ctx,
+                "input depth",
+                width,
+                height * layers,
+                TexelFormat::R32Float,
+                storage,
+            )?,
+            color_out: Image::new_2d(
+                ctx,
+                "splat output",
+                width,
+                height,
+                TexelFormat::Rgba32Float,
+                storage,
+            )?,
+            fragments: fragments::FragmentStore::new(ctx, pixels, per_chunk)?,
+            counts: Buffer::new(ctx, "tile counts", (tiles + 1) * 4, Residency::Device)?,
+            cursors: Buffer::new(ctx, "tile cursors", tiles * 4, Residency::Device)?,
+            offsets: Buffer::new(ctx, "tile offsets", (tiles + 1) * 4, Residency::Device)?,
+            block_sums: Buffer::new(
+                ctx,
+                "scan block sums",
+                tiles.div_ceil(1024) * 4,
+                Residency::Device,
+            )?,
+            uniform: Buffer::new(
+                ctx,
+                "splat frame uniforms",
+                FRAME_UNIFORM_BYTES,
+                Residency::Upload,
+            )?,
+            staging: None,
+            readback_color: Buffer::new(
+                ctx,
+                "output read-back",
+                pixels / u64::from(layers) * 16,
+                Residency::Readback,
+            )?,
+            readback_lists: Buffer::new(
+                ctx,
+                "list sizes read-back",
+                2 * (tiles + 1) * 4,
+                Residency::Readback,
+            )?,
+        });
+        self.texture_blend = None;
+        self.last_lists = None;
+        Ok(())
+    }
+
     pub fn field_axes(&self) -> Option<&crate::psf::field::FieldAxes> {
         self.field_axes.as_ref()
     }

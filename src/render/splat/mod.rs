@@ -29,9 +29,7 @@ mod tile_fill;
 mod tile_sort;
 mod uniform;
 
-use crate::gpu::{
-    Buffer, Context, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat, Timings,
-};
+use crate::gpu::{Buffer, Context, GpuError, Image, Residency, Sampler, Timings};
 use crate::psf::kernels::KernelGrid;
 
 use bands::{plan_bands, BandPush};
@@ -201,7 +199,7 @@ pub const MAX_OFF_AXIS_TILE: u32 = 16;
 pub(super) const FRAGMENT_BYTES: u64 = std::mem::size_of::<Fragment>() as u64;
 const ENTRY_BYTES: u64 = 8;
 
-fn binding_limit(ctx: &Context) -> u64 {
+pub(super) fn binding_limit(ctx: &Context) -> u64 {
     u64::from(ctx.limits().max_storage_buffer_range)
 }
 
@@ -223,97 +221,6 @@ impl Splatter {
     /// The PSF texture as the convolution pass samples it (for inspection and tests).
     pub fn psf_texture(&self) -> (&Image, &Sampler) {
         (&self.texture, &self.sampler)
-    }
-
-    fn ensure_frame(&mut self, width: u32, height: u32, layers: u32) -> crate::Result<()> {
-        if self
-            .frame
-            .as_ref()
-            .is_some_and(|f| f.width == width && f.height == height && f.layers == layers)
-        {
-            return Ok(());
-        }
-        let ctx = &self.ctx;
-        // every layer's pixels: the inputs and fragments are stacked layer under layer
-        let pixels = u64::from(width) * u64::from(height) * u64::from(layers);
-        let limit = binding_limit(ctx).min(self.settings.max_fragment_binding_bytes);
-        let Some(per_chunk) = fragments::fragments_per_chunk(pixels, limit) else {
-            return Err(crate::Error::input(format!(
-                "a {width}×{height} frame with {layers} depth layer(s) needs {} MiB of fragments, over \
-                 four of this device's {} MiB storage-buffer bindings; render at most {} pixels (all \
-                 layers) per frame on this device",
-                (pixels * FRAGMENT_BYTES) >> 20,
-                limit >> 20,
-                fragments::FRAGMENT_CHUNKS * (limit / FRAGMENT_BYTES)
-            )));
-        };
-        let tile = self.settings.tile_size;
-        let (tiles_x, tiles_y) = (width.div_ceil(tile), height.div_ceil(tile));
-        let tiles = u64::from(tiles_x) * u64::from(tiles_y);
-        let storage = ImageUsage::STORAGE;
-        self.frame = Some(FrameResources {
-            width,
-            height,
-            layers,
-            tiles_x,
-            tiles_y,
-            color_in: Image::new_2d(
-                ctx,
-                "input colour",
-                width,
-                height * layers,
-                TexelFormat::Rgba32Float,
-                storage,
-            )?,
-            depth_in: Image::new_2d(
-                ctx,
-                "input depth",
-                width,
-                height * layers,
-                TexelFormat::R32Float,
-                storage,
-            )?,
-            color_out: Image::new_2d(
-                ctx,
-                "splat output",
-                width,
-                height,
-                TexelFormat::Rgba32Float,
-                storage,
-            )?,
-            fragments: fragments::FragmentStore::new(ctx, pixels, per_chunk)?,
-            counts: Buffer::new(ctx, "tile counts", (tiles + 1) * 4, Residency::Device)?,
-            cursors: Buffer::new(ctx, "tile cursors", tiles * 4, Residency::Device)?,
-            offsets: Buffer::new(ctx, "tile offsets", (tiles + 1) * 4, Residency::Device)?,
-            block_sums: Buffer::new(
-                ctx,
-                "scan block sums",
-                tiles.div_ceil(1024) * 4,
-                Residency::Device,
-            )?,
-            uniform: Buffer::new(
-                ctx,
-                "splat frame uniforms",
-                FRAME_UNIFORM_BYTES,
-                Residency::Upload,
-            )?,
-            staging: None,
-            readback_color: Buffer::new(
-                ctx,
-                "output read-back",
-                pixels / u64::from(layers) * 16,
-                Residency::Readback,
-            )?,
-            readback_lists: Buffer::new(
-                ctx,
-                "list sizes read-back",
-                2 * (tiles + 1) * 4,
-                Residency::Readback,
-            )?,
-        });
-        self.texture_blend = None;
-        self.last_lists = None;
-        Ok(())
     }
 
     /// Renders one frame through the eye's kernels for `view`.
