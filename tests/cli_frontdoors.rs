@@ -461,6 +461,57 @@ fn compare_reports_quality_and_writes_maps() {
     }
 }
 
+/// `--judge` measures a saved image exactly as the methods are measured, and `--truth-bin-d`
+/// changes the reference: the default truth saved and judged again is identical to the bit,
+/// a truth rounded to 0.1 D bins is not.
+#[test]
+fn compare_judges_saved_images_and_coarse_truths() {
+    let dir = temp_dir("judge");
+    let (fine, coarse) = (dir.join("fine.exr"), dir.join("coarse.exr"));
+    let json = dir.join("judge.json");
+    let common = ["compare", "--size", "96x54", "--no-slices", "--cache"];
+    let run = |extra: &[&std::ffi::OsStr]| {
+        run_ok(ocular().args(common).arg(cache()).args(extra));
+    };
+    run(&["--truth-out".as_ref(), fine.as_os_str()]);
+    run(&[
+        "--truth-bin-d".as_ref(),
+        "0.1".as_ref(),
+        "--truth-out".as_ref(),
+        coarse.as_os_str(),
+    ]);
+    run(&[
+        "--judge".as_ref(),
+        fine.as_os_str(),
+        "--judge".as_ref(),
+        coarse.as_os_str(),
+        "--json".as_ref(),
+        json.as_os_str(),
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(report["truth_bin_d"].as_f64(), Some(0.001));
+    let row = |name: &str| {
+        report["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == name)
+            .unwrap_or_else(|| panic!("no row {name}: {report}"))
+            .clone()
+    };
+    assert!(row("fine")["psnr_db"].is_null(), "{}", row("fine"));
+    let coarse_db = row("coarse")["psnr_db"].as_f64();
+    assert!(
+        coarse_db.is_some_and(f64::is_finite),
+        "0.1 D bins must change the truth: {}",
+        row("coarse")
+    );
+    assert!(
+        row("coarse")["seconds"].is_null(),
+        "a judged file has no time"
+    );
+}
+
 /// `render --scene FILE` without `--size` renders at the scene's `[camera] resolution`, as
 /// scenes/README.md promises (it used to render 640×360 whatever the file said).
 #[test]

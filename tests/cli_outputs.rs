@@ -220,6 +220,51 @@ fn compare_refuses_a_ground_truth_holding_nan() {
 }
 
 #[test]
+fn compare_judge_and_truth_bin_are_checked_before_rendering() {
+    let d = scratch("judge");
+    let nan = d.join("other.exr");
+    let mut pixels = vec![[0.5f32, 0.5, 0.5, 1.0]; 64 * 36];
+    pixels[2 * 64 + 9][2] = f32::NAN;
+    ocular::image_io::write_exr_rgba(&nan, &ocular::image_io::ImageRgba::new(64, 36, pixels))
+        .unwrap();
+    refused(
+        &ocular(&["compare", "--size", "64x36", "--judge", p(&nan)]),
+        &["--judge", "other.exr", "1 pixels", "x = 9, y = 2"],
+    );
+    let small = d.join("small.exr");
+    ocular::image_io::write_exr_rgba(
+        &small,
+        &ocular::image_io::ImageRgba::new(32, 18, vec![[0.5f32, 0.5, 0.5, 1.0]; 32 * 18]),
+    )
+    .unwrap();
+    refused(
+        &ocular(&["compare", "--size", "64x36", "--judge", p(&small)]),
+        &["--judge", "small.exr", "32×18", "64×36"],
+    );
+    let named_splat = d.join("splat.exr");
+    std::fs::copy(&small, &named_splat).unwrap();
+    refused(
+        &ocular(&["compare", "--judge", p(&named_splat)]),
+        &["--judge", "splat.exr", "`splat`"],
+    );
+    // clap's parser errors add a hint line; the first line names the option and the value
+    for bad in ["0", "0.2", "x"] {
+        let out = ocular(&["compare", "--truth-bin-d", bad]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        let first = err.lines().next().unwrap_or_default();
+        assert!(
+            first.contains("--truth-bin-d") && first.contains(bad),
+            "{err}"
+        );
+    }
+    refused(
+        &ocular(&["compare", "--truth-bin-d", "0.01", "--truth-in", p(&small)]),
+        &["--truth-bin-d", "--truth-in"],
+    );
+}
+
+#[test]
 fn frame_sizes_are_checked_where_they_are_parsed() {
     let d = scratch("size");
     let frames = d.join("frames");

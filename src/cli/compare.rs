@@ -65,6 +65,17 @@ pub struct CompareArgs {
     /// instead of rendering it: sweeps keep one truth while the settings vary.
     #[arg(long, value_name = "FILE.exr")]
     pub truth_in: Option<PathBuf>,
+    /// Also judge a saved linear EXR of this frame against the truth (repeatable; the row is
+    /// named after the file): another renderer's output, or a truth saved with --truth-out at
+    /// other settings, which measures the truth's own convergence.
+    #[arg(long, value_name = "FILE.exr")]
+    pub judge: Vec<PathBuf>,
+    /// Dioptre bin of the reference truth: each pixel's vergence is rounded to it (0.0001 to
+    /// 0.1; default 0.001, the seed paper's 3 decimals). Off axis every pair of vergence bin and
+    /// 1° direction costs its own PSFs; 0.01 makes a deep 1280×720 scene affordable and moves a
+    /// blur diameter by at most 0.005 D × the pupil diameter.
+    #[arg(long, value_name = "D", value_parser = parse_truth_bin_d)]
+    pub truth_bin_d: Option<f64>,
     /// Skip the slice method.
     #[arg(long)]
     pub no_slices: bool,
@@ -118,7 +129,7 @@ pub struct ViewsConvergence {
 
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct MethodResult {
-    pub method: &'static str,
+    pub method: String,
     pub seconds: f64,
     pub psnr_db: f64,
     pub mssim: f64,
@@ -145,6 +156,8 @@ struct Report {
     truth: &'static str,
     /// What the ground truth shares with splat (what it cannot judge).
     truth_shares: &'static str,
+    /// The reference's dioptre bin (null for the views truth or a truth from --truth-in).
+    truth_bin_d: Option<f64>,
     /// The views truth's own convergence (null for the reference truth or --truth-in).
     views_convergence: Option<ViewsConvergence>,
     methods: Vec<MethodResult>,
@@ -192,6 +205,27 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             args.object_samples
         )));
     }
+    let mut rows: Vec<String> = [
+        "truth",
+        "reference",
+        "views",
+        "splat",
+        "splat-layers",
+        "slices",
+    ]
+    .map(String::from)
+    .to_vec();
+    for path in &args.judge {
+        let name = judged_name(path);
+        if rows.contains(&name) {
+            return Err(Error::input(format!(
+                "--judge {}: its row would be named `{name}`, which another row has; rename the \
+                 file",
+                path.display()
+            )));
+        }
+        rows.push(name);
+    }
     // Declared before the outputs so that it is dropped after their temporaries are.
     let maps_created = match &args.maps {
         Some(dir) => Some(maps_folder(dir)?),
@@ -212,9 +246,39 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         ) {
             outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
         }
+        for name in args.judge.iter().map(|p| judged_name(p)) {
+            outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
+            outputs.add("--maps", &dir.join(format!("ssim_{name}.png")), &["png"])?;
+        }
     }
     outputs.probe()?;
-    let truth_in = args.truth_in.as_ref().map(read_truth).transpose()?;
+    if args.truth_bin_d.is_some() && args.truth_in.is_some() && args.truth == TruthArg::Reference {
+        return Err(Error::input(
+            "--truth-bin-d applies to a rendered reference; --truth-in reads one",
+        ));
+    }
+    let truth_in = args
+        .truth_in
+        .as_ref()
+        .map(|p| read_truth("--truth-in", p))
+        .transpose()?;
+    let judged: Vec<(String, ImageRgba)> = args
+        .judge
+        .iter()
+        .map(|p| Ok((judged_name(p), read_truth("--judge", p)?)))
+        .collect::<Result<_>>()?;
+    for (path, (_, image)) in args.judge.iter().zip(&judged) {
+        if (image.width, image.height) != args.size {
+            return Err(Error::input(format!(
+                "--judge {} is {}×{}, the frame is {}×{}",
+                path.display(),
+                image.width,
+                image.height,
+                args.size.0,
+                args.size.1
+            )));
+        }
+    }
     let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
@@ -250,6 +314,9 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     }
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     renderer.slice_count = args.slices;
+    if let Some(bin) = args.truth_bin_d {
+        renderer.reference_dioptre_bin_d = bin;
+    }
     let input = FrameInput {
         width,
         height,
@@ -383,15 +450,31 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let mut methods = Vec::new();
     let mut maps = Vec::new();
     let mut window_px = 11;
-    let frames: Vec<(&RenderedFrame, &'static str, u32)> = [
-        Some((&truth, truth_method.name(), 1)),
-        reference_frame.as_ref().map(|f| (f, "reference", 1)),
-        Some((&splat_frame, "splat", 1)),
-        layered_frame.as_ref().map(|f| (f, "splat-layers", layers)),
-        slices_frame.as_ref().map(|f| (f, "slices", 1)),
+    let judged_frames: Vec<(RenderedFrame, String)> = judged
+        .into_iter()
+        .map(|(name, image)| {
+            let frame = RenderedFrame {
+                color: image.pixels,
+                method: truth_method,
+                seconds: f64::NAN,
+                timings: None,
+                stats: None,
+            };
+            (frame, name)
+        })
+        .collect();
+    let frames: Vec<(&RenderedFrame, String, u32)> = [
+        Some((&truth, truth_method.name().to_string(), 1)),
+        reference_frame.as_ref().map(|f| (f, "reference".into(), 1)),
+        Some((&splat_frame, "splat".into(), 1)),
+        layered_frame
+            .as_ref()
+            .map(|f| (f, "splat-layers".into(), layers)),
+        slices_frame.as_ref().map(|f| (f, "slices".into(), 1)),
     ]
     .into_iter()
     .flatten()
+    .chain(judged_frames.iter().map(|(f, name)| (f, name.clone(), 1)))
     .collect();
     let band = super::edge_band::edge_band(
         &frame.depth_m,
@@ -401,7 +484,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         (pupil_mm, focus_d),
         f64::from(splat.blend.group_tolerance_d),
     );
-    for &(frame, name, frame_layers) in &frames {
+    for (frame, name, frame_layers) in &frames {
+        let (frame, frame_layers) = (*frame, *frame_layers);
         if let Some((count, first)) = non_finite(&frame.color, w) {
             return Err(Error::input(format!(
                 "the {} image has {count} pixels that are not finite (first at x = {}, y = {}); \
@@ -419,7 +503,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         );
         let edge_band = super::edge_band::band_quality(&image, &truth01, &quality.map, &band, w);
         methods.push(MethodResult {
-            method: name,
+            method: name.clone(),
             layers: frame_layers,
             edge_band,
             seconds: frame.seconds,
@@ -512,7 +596,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             mode: TonemapMode::Clamp,
         };
         for (i, frame) in frames.iter().enumerate() {
-            let name = if i == 0 { "truth" } else { frame.1 };
+            let name = if i == 0 { "truth" } else { frame.1.as_str() };
             let image = ImageRgba::new(width, height, frame.0.color.clone());
             image_io::write_png(
                 outputs.temporary(&dir.join(format!("{name}.png"))),
@@ -553,6 +637,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 "reference"
             },
             truth_shares,
+            truth_bin_d: (truth_method == Method::Reference && args.truth_in.is_none())
+                .then_some(renderer.reference_dioptre_bin_d),
             views_convergence,
             methods,
         };
@@ -628,17 +714,37 @@ fn maps_folder(dir: &std::path::Path) -> Result<CreatedFolder> {
     Ok(CreatedFolder(Some(dir.to_path_buf())))
 }
 
-/// `--truth-in`, refused if any colour value is not finite (metrics of NaN are not numbers).
-fn read_truth(path: &PathBuf) -> Result<ImageRgba> {
+/// An image for `--truth-in` or `--judge`, refused if any colour value is not finite (metrics
+/// of NaN are not numbers).
+fn read_truth(option: &str, path: &PathBuf) -> Result<ImageRgba> {
     let image = image_io::read_exr_rgba(path)?;
     if let Some((count, (x, y))) = non_finite(&image.pixels, image.width as usize) {
         return Err(Error::input(format!(
-            "--truth-in {}: {count} pixels are not finite (first at x = {x}, y = {y}); a ground \
-             truth must hold finite colour",
+            "{option} {}: {count} pixels are not finite (first at x = {x}, y = {y}); an image \
+             to judge or judge by must hold finite colour",
             path.display()
         )));
     }
     Ok(image)
+}
+
+/// The row of a `--judge` image: its file name without the extension.
+fn judged_name(path: &std::path::Path) -> String {
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
+    stem.filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "judged".to_string())
+}
+
+/// `--truth-bin-d`: a dioptre bin from 0.0001 to 0.1.
+fn parse_truth_bin_d(text: &str) -> std::result::Result<f64, String> {
+    let bin: f64 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of dioptres"))?;
+    if !(1e-4..=0.1).contains(&bin) {
+        return Err(format!("{bin} is outside 0.0001 to 0.1 D"));
+    }
+    Ok(bin)
 }
 
 /// How many pixels have a non-finite R, G or B, and the first one's (x, y).

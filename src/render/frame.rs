@@ -15,6 +15,7 @@ use crate::psf::field_plan::{plan_for_frame, FieldPlan};
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::KernelGrid;
 use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
+use crate::render::blend::BlendSettings;
 use crate::render::splat::{
     FrameInput, RecordedInput, SplatSettings, SplatStats, Splatter, ViewState,
 };
@@ -272,6 +273,8 @@ pub struct FrameRenderer {
     pub slice_count: usize,
     /// Off axis, the reference traces the eye for every field bin of this many degrees.
     pub reference_field_step_deg: f64,
+    /// The reference rounds vergences to bins of this many dioptres.
+    pub reference_dioptre_bin_d: f64,
 }
 
 /// Default field bin of the off-axis reference (degrees): a tenth of a typical lattice step,
@@ -295,6 +298,7 @@ impl FrameRenderer {
             splatter: None,
             slice_count: slices::DEFAULT_SLICES,
             reference_field_step_deg: REFERENCE_FIELD_STEP_DEG,
+            reference_dioptre_bin_d: reference::DIOPTRE_BIN_D,
         }
     }
 
@@ -384,14 +388,24 @@ impl FrameRenderer {
                     let wavelengths = self.kernels.grid.wavelengths_nm;
                     let field =
                         ExactFieldEye::new(exact, wavelengths, self.reference_field_step_deg)?;
-                    reference::render(input, &field)
+                    reference::render_binned(
+                        input,
+                        &field,
+                        &BlendSettings::default(),
+                        self.reference_dioptre_bin_d,
+                    )
                 } else if self.kernels.field.is_some() {
                     return Err(Error::input(
                         "--off-axis applies to --method splat and reference; slices use one PSF \
                          per depth slice",
                     ));
                 } else if method == Method::Reference {
-                    reference::render(input, &exact)
+                    reference::render_binned(
+                        input,
+                        &exact,
+                        &BlendSettings::default(),
+                        self.reference_dioptre_bin_d,
+                    )
                 } else {
                     slices::render(input, &exact, self.slice_count)
                 };

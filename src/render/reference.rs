@@ -29,8 +29,8 @@ pub fn dioptre_of_depth(depth_m: f32) -> f64 {
     }
 }
 
-fn bin_of(dioptre: f64) -> i64 {
-    (dioptre / DIOPTRE_BIN_D).round() as i64
+fn bin_of(dioptre: f64, bin_d: f64) -> i64 {
+    (dioptre / bin_d).round() as i64
 }
 
 /// Renders the ground truth with the default blend (depth groups, wide-field geometry).
@@ -45,6 +45,23 @@ pub fn render_with(
     kernels: &dyn ExactKernels,
     blend: &BlendSettings,
 ) -> Vec<[f32; 4]> {
+    render_binned(input, kernels, blend, DIOPTRE_BIN_D)
+}
+
+/// Renders the ground truth with vergences rounded to bins of `dioptre_bin_d` instead of the
+/// seed paper's 0.001 D. A bin of b D moves a kernel's blur diameter by at most
+/// b/2 × pupil diameter (rad): coarser bins make a whole off-axis scene affordable, where every
+/// (vergence, direction) pair costs its own PSFs, at an error `compare --judge` measures.
+pub fn render_binned(
+    input: &FrameInput<'_>,
+    kernels: &dyn ExactKernels,
+    blend: &BlendSettings,
+    dioptre_bin_d: f64,
+) -> Vec<[f32; 4]> {
+    assert!(
+        dioptre_bin_d > 0.0 && dioptre_bin_d.is_finite(),
+        "dioptre bin must be positive"
+    );
     let (w, h) = (input.width as usize, input.height as usize);
     let projection = input.projection();
     let wide = blend.wide_field;
@@ -71,9 +88,9 @@ pub fn render_with(
     let bins: Vec<Bin> = dioptres
         .iter()
         .zip(&field_bins)
-        .map(|(&d, &(fh, fv))| (bin_of(d), fh, fv))
+        .map(|(&d, &(fh, fv))| (bin_of(d, dioptre_bin_d), fh, fv))
         .collect();
-    let kernel_table = exact_kernels_for(&bins, kernels);
+    let kernel_table = exact_kernels_for(&bins, kernels, dioptre_bin_d);
     let lookup = |channel: usize, bin: Bin| -> &Kernel { &kernel_table[&(channel, bin)] };
     let scales: Vec<LocalScale> = (0..w * h)
         .map(|i| {
@@ -183,6 +200,7 @@ type Bin = (i64, i64, i64);
 fn exact_kernels_for(
     bins: &[Bin],
     kernels: &dyn ExactKernels,
+    dioptre_bin_d: f64,
 ) -> HashMap<(usize, Bin), Arc<Kernel>> {
     let mut distinct: Vec<Bin> = bins.to_vec();
     distinct.sort_unstable();
@@ -199,7 +217,7 @@ fn exact_kernels_for(
     jobs.into_par_iter()
         .map(|(c, b)| {
             let field = [b.1 as f64 * step, b.2 as f64 * step];
-            let k = kernels.kernel_in_field(c, b.0 as f64 * DIOPTRE_BIN_D, field);
+            let k = kernels.kernel_in_field(c, b.0 as f64 * dioptre_bin_d, field);
             ((c, b), Arc::new(k))
         })
         .collect()
@@ -211,7 +229,7 @@ pub fn distinct_bins(input: &FrameInput<'_>) -> usize {
         .projection()
         .dioptres(input.depth_m)
         .iter()
-        .map(|&d| bin_of(d))
+        .map(|&d| bin_of(d, DIOPTRE_BIN_D))
         .collect();
     bins.sort_unstable();
     bins.dedup();
