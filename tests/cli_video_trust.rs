@@ -97,6 +97,10 @@ fn a_resume_with_another_configuration_is_refused() {
     );
     refused(&video(&dir, &["--fps", "20"]), &["--fps"]);
     refused(&video(&dir, &["--pupil-mm", "3"]), &["--pupil-mm"]);
+    refused(
+        &video(&dir, &["--layers", "2"]),
+        &["--layers 1 there, 2 here"],
+    );
     assert_eq!(
         frames(&dir),
         before,
@@ -117,6 +121,20 @@ fn a_resume_with_another_configuration_is_refused() {
         "the myopic frames differ from the Navarro ones"
     );
     refused(&video(&dir, &[]), &["--eye myopia there, navarro here"]);
+
+    // Two layers: primitives' hidden surfaces show through the blurred edges of the sweep.
+    let report = ok(&video(
+        &dir,
+        &["--eye", "myopia", "--layers", "2", "--overwrite"],
+    ));
+    assert!(report.contains("rendered 4"), "{report}");
+    let layered = frames(&dir);
+    assert_eq!(layered.len(), 4);
+    assert_ne!(layered, after, "hidden layers change the blurred frames");
+    refused(
+        &video(&dir, &["--eye", "myopia"]),
+        &["--layers 2 there, 1 here"],
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

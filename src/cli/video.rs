@@ -100,6 +100,11 @@ pub struct VideoArgs {
     /// the eye traced for its own direction, mixed from a lattice planned from the frame.
     #[arg(long)]
     pub off_axis: bool,
+    /// Depth layers splat takes (1–8; default 1): each frame is depth-peeled to K layers, and
+    /// hidden surfaces show through blurred edges where the pupil sees past them (as `render
+    /// --layers`).
+    #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
+    pub layers: Option<u32>,
     /// Kernel cache folder; --no-cache disables it.
     #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
     pub cache: Option<PathBuf>,
@@ -379,6 +384,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         focus_sweep_m: sweep.map(|(a, b)| [a, b]),
         pupil_mm: args.pupil_mm,
         exposure_ev: args.exposure,
+        layers: args.layers.filter(|&k| k > 1),
         settings_sha256: {
             let planned = planning_frames(count);
             let mut parts: Vec<&dyn std::fmt::Debug> = vec![
@@ -392,9 +398,21 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             if args.off_axis {
                 parts.push(&"off-axis");
             }
+
             sha256_of_debug(&parts)
         },
     };
+    // Checked before the manifest is published: a refused run leaves the folder as it was.
+    let ctx = Context::new(&cli.context_options())?;
+    if let Some(k) = args.layers {
+        let fit = crate::render::splat::max_layers(&ctx, width, height).max(1);
+        if k > fit {
+            return Err(Error::input(format!(
+                "--layers {k}: at {width}×{height} this device fits {fit} (its storage-buffer \
+                 limit); lower --layers or --size"
+            )));
+        }
+    }
     let removed = manifest::open(&args.output, &config, args.overwrite)?;
     if removed > 0 {
         eprintln!(
@@ -427,7 +445,6 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     let skipped = (end - first) - todo.len();
     let mut log = DigestLog::create(&args.output)?;
 
-    let ctx = Context::new(&cli.context_options())?;
     let mut rasterizer = Rasterizer::new(&ctx)?;
     let fov_y_deg = timeline.state(0).camera.fov_y_deg;
     let screen = Screen {

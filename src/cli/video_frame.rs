@@ -66,7 +66,11 @@ pub(super) fn render_panels(
     magnifications: &[Option<[[f64; 2]; 2]>],
 ) -> Result<Vec<Vec<[f32; 4]>>> {
     // Read back only where the pupil needs the pixels; then that frame also serves the
-    // panels seen without a spectacle.
+    // panels seen without a spectacle, unless they take hidden layers (peeled on the GPU).
+    let layers = args.layers.unwrap_or(crate::render::raster::DEFAULT_LAYERS);
+    let gap_d = crate::render::splat::SplatSettings::default()
+        .blend
+        .group_tolerance_d;
     let measured = if pupil_needs_frame(args, state) {
         rasterizer.set_view_magnification(IDENTITY);
         Some(rasterizer.render(ctx, state, size.0, size.1)?)
@@ -80,7 +84,7 @@ pub(super) fn render_panels(
     let mut panels = Vec::new();
     for (renderer, magnification) in renderers.iter_mut().zip(magnifications) {
         let out = match (&measured, magnification) {
-            (Some(frame), None) => {
+            (Some(frame), None) if layers == 1 => {
                 let input = FrameInput {
                     width: size.0,
                     height: size.1,
@@ -93,7 +97,9 @@ pub(super) fn render_panels(
             }
             _ => {
                 rasterizer.set_view_magnification(magnification.unwrap_or(IDENTITY));
-                let mut frame = rasterizer.scene_frame(ctx, state, size);
+                let mut frame = rasterizer
+                    .scene_frame(ctx, state, size)
+                    .peeled(layers, gap_d);
                 renderer.render_recorded(&mut frame, eye_state)?
             }
         };

@@ -40,6 +40,9 @@ pub struct ExportConfig {
     pub focus_sweep_m: Option<[f64; 2]>,
     pub pupil_mm: Option<f64>,
     pub exposure_ev: Option<f32>,
+    /// Depth layers above one (absent for one, so one-layer manifests read as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub layers: Option<u32>,
     /// SHA-256 of the kernel and splatting settings.
     pub settings_sha256: String,
 }
@@ -153,6 +156,14 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
             "--exposure {} there, {} here",
             shown(&old.exposure_ev),
             shown(&new.exposure_ev)
+        ),
+    );
+    field(
+        old.layers != new.layers,
+        format!(
+            "--layers {} there, {} here",
+            old.layers.unwrap_or(1),
+            new.layers.unwrap_or(1)
         ),
     );
     field(
