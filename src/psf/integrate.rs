@@ -88,13 +88,22 @@ impl BoxIntegrator {
             .max(w.div_ceil(max_bins.max(8)));
         let m = w.div_ceil(bin);
         let mut bins = vec![0.0f64; m * m];
+        // Each row is merged into column bins once, then spread over the five rows of cells
+        // its taps reach: the vertical pass costs m per tap, not w.
+        let mut merged = vec![0.0f64; m];
         for q in 0..side {
             let src = &rows[q * w..(q + 1) * w];
+            if src.iter().all(|&v| v == 0.0) {
+                continue;
+            }
+            for (c, chunk) in merged.iter_mut().zip(src.chunks(bin)) {
+                *c = chunk.iter().sum();
+            }
             for (t, g) in taps.iter().enumerate() {
                 let cq = (q + 4 - t) / bin;
                 let dst = &mut bins[cq * m..(cq + 1) * m];
-                for (i, v) in src.iter().enumerate() {
-                    dst[i / bin] += v * g;
+                for (d, v) in dst.iter_mut().zip(&merged) {
+                    *d += v * g;
                 }
             }
         }
