@@ -175,6 +175,11 @@ direction (the eye traced for every 1° field bin, no lattice); it shares the bl
 pinhole's local layout and the PSF computation of a direction with splat, so it judges the \
 field lattice and its interpolation as well as the kernel approximations, not the optics";
 
+/// A truth read with --truth-in: what it shares is what the run that saved it shared.
+const LOADED_TRUTH_SHARES: &str = "ground truth: read with --truth-in; it shares with these \
+methods what the run that saved it said (e.g. an off-axis reference judging on-axis splat \
+measures what the field's aberrations change)";
+
 /// What the views truth has in common with the methods it judges.
 const VIEWS_SHARES: &str = "ground truth: multi-view accumulation over the pupil (geometric \
 optics, rasterised from each pupil point, each channel shifted by the eye's ray aberration); it \
@@ -535,7 +540,9 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         args.eye,
         ctx.device_info().name
     );
-    let truth_shares = if truth_method == Method::Views {
+    let truth_shares = if args.truth_in.is_some() {
+        LOADED_TRUTH_SHARES
+    } else if truth_method == Method::Views {
         VIEWS_SHARES
     } else if args.splat.off_axis {
         FIELD_TRUTH_SHARES
@@ -571,14 +578,15 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         } else {
             format!("{:.2}", m.edge_band.psnr_db)
         };
-        let (seconds, speedup) = if m.seconds.is_nan() {
-            ("—".to_string(), "—".to_string())
-        } else {
-            (
-                format!("{:.3}", m.seconds),
-                format!("{:.1}", m.speedup_vs_reference),
-            )
+        // a truth read from a file has no time, so neither has a speed-up against it
+        let shown = |v: f64, digits: usize| {
+            if v.is_finite() {
+                format!("{v:.digits$}")
+            } else {
+                "—".to_string()
+            }
         };
+        let (seconds, speedup) = (shown(m.seconds, 3), shown(m.speedup_vs_reference, 1));
         println!(
             "  {:<13} {:>10} {:>10.4} {:>10} {:>12}   {:>28} {:>8.4}",
             m.method, db, m.mssim, seconds, speedup, band_db, m.edge_band.mssim
