@@ -55,7 +55,7 @@ for pair in pairs:
     scene, eye = pair.split(":")
     r, m = rows(f"{out}/{scene}-{eye}.json")
     _, c = rows(f"{out}/{scene}-{eye}-onaxis.json")
-    print(f"| {scene} | {eye} | {r['truth_bin_d']} D | {cell(m['splat'])} | {cell(c['splat'])} "
+    print(f"| {scene} | {eye} | {r.get('truth_bin_d') or 0.001} D | {cell(m['splat'])} | {cell(c['splat'])} "
           f"| {m['splat']['seconds']:.0f} | {m['reference']['seconds']:.0f} |")
 path = f"{out}/bin-colonnade.json"
 if os.path.exists(path):
