@@ -9,8 +9,8 @@
 #   chart and colonnade × healthy, myopia, astigmatism, keratoconus. BIN_CHECK=0 skips the
 #   bin check.
 # Chart's truth keeps the seed paper's 0.001 D bins; colonnade's rounds vergences to 0.02 D:
-# off axis every (vergence bin, direction) pair costs its own FFT PSFs, 109 000 pairs at
-# 0.001 D against 13 100 at 0.02 D for colonnade at 1280×720. On 2 CPU cores one chart pair
+# off axis every (vergence bin, direction) pair costs its own FFT PSFs, far more pairs in a
+# deep scene at 0.001 D than in a flat one. On 2 CPU cores one chart pair
 # takes about 30 minutes (reference 18 min, the off-axis splat frame 5 min, rendered twice).
 set -euo pipefail
 bin=${1:-target/release/ocular}
