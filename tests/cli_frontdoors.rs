@@ -25,6 +25,17 @@ fn cache() -> PathBuf {
     dir
 }
 
+/// The row of `compare --json`'s report for one method (or judged file).
+fn method_row(report: &serde_json::Value, name: &str) -> serde_json::Value {
+    report["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == name)
+        .unwrap_or_else(|| panic!("no row {name}: {report}"))
+        .clone()
+}
+
 fn run_ok(cmd: &mut Command) -> String {
     let out = cmd.output().unwrap();
     assert!(
@@ -424,15 +435,7 @@ fn compare_reports_quality_and_writes_maps() {
             .arg(dir.join("maps")),
     );
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
-    let method = |name: &str| {
-        report["methods"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|m| m["method"] == name)
-            .unwrap()
-            .clone()
-    };
+    let method = |name: &str| method_row(&report, name);
     // At this size the blur is a pixel or two, where every method is close to the truth; the
     // ranking under strong blur is asserted in tests/slices.rs.
     let (truth, splat, slices) = (method("reference"), method("splat"), method("slices"));
@@ -490,15 +493,7 @@ fn compare_judges_saved_images_and_coarse_truths() {
     ]);
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     assert_eq!(report["truth_bin_d"].as_f64(), Some(0.001));
-    let row = |name: &str| {
-        report["methods"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|m| m["method"] == name)
-            .unwrap_or_else(|| panic!("no row {name}: {report}"))
-            .clone()
-    };
+    let row = |name: &str| method_row(&report, name);
     assert!(row("fine")["psnr_db"].is_null(), "{}", row("fine"));
     let coarse_db = row("coarse")["psnr_db"].as_f64();
     assert!(
