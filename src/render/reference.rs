@@ -5,7 +5,6 @@
 //! pipeline, not the blend; the blend is judged against plain convolutions in the tests). It is
 //! written independently of the GPU passes (CPU, rayon, per tile).
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use rayon::prelude::*;
@@ -90,8 +89,14 @@ pub fn render_binned(
         .zip(&field_bins)
         .map(|(&d, &(fh, fv))| (bin_of(d, dioptre_bin_d), fh, fv))
         .collect();
-    let kernel_table = exact_kernels_for(&bins, kernels, dioptre_bin_d);
-    let lookup = |channel: usize, bin: Bin| -> &Kernel { &kernel_table[&(channel, bin)] };
+    // Each pixel's three kernels are found once here, not per (pixel, fragment, channel) in the
+    // loop below, where a keyed lookup was a sixth of the time.
+    let (distinct, kernel_table) = exact_kernels_for(&bins, kernels, dioptre_bin_d);
+    let slots: Vec<usize> = bins
+        .iter()
+        .map(|b| distinct.binary_search(b).expect("every bin has kernels"))
+        .collect();
+    let kernel_of = |i: usize| -> &[Arc<Kernel>; 3] { &kernel_table[slots[i]] };
     let scales: Vec<LocalScale> = (0..w * h)
         .map(|i| {
             if wide {
@@ -106,9 +111,8 @@ pub fn render_binned(
     // channels, stretched by the local scale (bilinear lookups reach one texel further).
     // The largest kernel radius over each fragment's channels sets how much of the local scale
     // applies, and with it the fragment's reach in screen pixels.
-    let natural: Vec<u32> = bins
-        .iter()
-        .map(|&b| (0..3).map(|c| lookup(c, b).radius).max().unwrap_or(0))
+    let natural: Vec<u32> = (0..w * h)
+        .map(|i| kernel_of(i).iter().map(|k| k.radius).max().unwrap_or(0))
         .collect();
     let reach: Vec<i64> = natural
         .iter()
@@ -165,15 +169,16 @@ pub fn render_binned(
                         let s = &scales[i];
                         let d = [(px - fx) as f64, (py - fy) as f64];
                         let r = f64::from(natural[i]);
-                        for (ch, p) in pixel.iter_mut().enumerate() {
-                            let k = lookup(ch, bins[i]);
-                            let weight = if s.for_radius(r)[0] < 1.0 {
+                        let scaled = s.for_radius(r)[0] < 1.0;
+                        for ((p, k), &c) in pixel.iter_mut().zip(kernel_of(i)).zip(&input.color[i])
+                        {
+                            let weight = if scaled {
                                 let [kx, ky] = s.kernel_offset(d, r);
                                 k.sample(kx, ky) * s.area_factor(r) as f32
                             } else {
                                 k.at(d[0] as i64, d[1] as i64)
                             };
-                            p.add(blend, dioptres[i] as f32, weight, input.color[i][ch]);
+                            p.add(blend, dioptres[i] as f32, weight, c);
                         }
                     }
                     let value = pixel.map(PixelBlend::resolve);
@@ -196,12 +201,13 @@ pub fn render_binned(
 /// A pixel's kernel bin: dioptre bin, then field bins along h and v (0 on axis).
 type Bin = (i64, i64, i64);
 
-/// Computes each distinct (channel, bin) kernel once, in parallel.
+/// Computes each distinct (channel, bin) kernel once, in parallel. Returns the distinct bins,
+/// sorted, and their kernels per channel in the same order.
 fn exact_kernels_for(
     bins: &[Bin],
     kernels: &dyn ExactKernels,
     dioptre_bin_d: f64,
-) -> HashMap<(usize, Bin), Arc<Kernel>> {
+) -> (Vec<Bin>, Vec<[Arc<Kernel>; 3]>) {
     let mut distinct: Vec<Bin> = bins.to_vec();
     distinct.sort_unstable();
     distinct.dedup();
@@ -214,13 +220,18 @@ fn exact_kernels_for(
     fields.sort_unstable();
     fields.dedup();
     kernels.prepare_field_bins(&fields);
-    jobs.into_par_iter()
+    let computed: Vec<Arc<Kernel>> = jobs
+        .into_par_iter()
         .map(|(c, b)| {
             let field = [b.1 as f64 * step, b.2 as f64 * step];
-            let k = kernels.kernel_in_field(c, b.0 as f64 * dioptre_bin_d, field);
-            ((c, b), Arc::new(k))
+            Arc::new(kernels.kernel_in_field(c, b.0 as f64 * dioptre_bin_d, field))
         })
-        .collect()
+        .collect();
+    let table = computed
+        .chunks_exact(3)
+        .map(|k| [k[0].clone(), k[1].clone(), k[2].clone()])
+        .collect();
+    (distinct, table)
 }
 
 /// Number of distinct dioptre bins of a frame (what the ground truth must compute).
