@@ -35,6 +35,17 @@ pub enum GpuError {
     },
     #[error("GPU pass \"{pass}\": {message}")]
     Usage { pass: String, message: String },
+    #[error(
+        "the \"{pass}\" pass left {unwritten} of {total} pixels unwritten (the first at x {x}, \
+         y {y}): the device dropped part of the work, so no image is returned"
+    )]
+    DroppedWork {
+        pass: String,
+        unwritten: usize,
+        total: usize,
+        x: usize,
+        y: usize,
+    },
 }
 
 pub type GpuResult<T> = Result<T, GpuError>;

@@ -359,8 +359,10 @@ impl Splatter {
                     upload_bytes,
                     readback_bytes: output_bytes + 8,
                 };
+                let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
+                check_every_pixel_written(&color, w as usize)?;
                 return Ok(SplatOutput {
-                    color: read_mapped(&frame.readback_color),
+                    color,
                     timings: merge_repeated(timings),
                     stats,
                     intermediates: None,
@@ -436,6 +438,7 @@ impl Splatter {
         self.texture_blend = Some(blend);
         self.last_lists = Some((total, bands.len()));
         let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
+        check_every_pixel_written(&color, w as usize)?;
         let stats = SplatStats {
             fragments: pixels as u64,
             live_fragments: live,
@@ -539,6 +542,9 @@ impl Splatter {
             )?;
         }
         rec.begin_pass("tile count");
+        // Alpha 0 marks a pixel the convolution has not written (it writes alpha 1 to every
+        // pixel of its tiles): the host checks the frame it reads back.
+        rec.clear_image(&frame.color_out, [0.0; 4]);
         rec.fill_buffer(&frame.counts, 0);
         self.tile_count
             .record(rec, block, &frame.fragments, &frame.counts)?;
@@ -626,6 +632,23 @@ fn entries_in(entries: &Buffer) -> u32 {
     (entries.size_bytes() / ENTRY_BYTES).min(u64::from(u32::MAX)) as u32
 }
 
+/// Refuses a frame in which the convolution left pixels unwritten (alpha still 0 from the
+/// clear). Lavapipe (Mesa 22.3) was seen to drop whole rows of some workgroups' pixels on tiles
+/// with very long lists (off axis at 960×540 and up): a partial frame must not reach an output.
+fn check_every_pixel_written(color: &[[f32; 4]], width: usize) -> crate::gpu::GpuResult<()> {
+    let mut unwritten = color.iter().enumerate().filter(|(_, p)| p[3] != 1.0);
+    let Some((first, _)) = unwritten.next() else {
+        return Ok(());
+    };
+    Err(GpuError::DroppedWork {
+        pass: "convolve".into(),
+        unwritten: 1 + unwritten.count(),
+        total: color.len(),
+        x: first % width.max(1),
+        y: first / width.max(1),
+    })
+}
+
 /// The contents of a host-visible read-back buffer.
 fn read_mapped<T: bytemuck::Pod>(buffer: &Buffer) -> Vec<T> {
     let bytes = buffer
@@ -645,4 +668,30 @@ fn merge_repeated(timings: Timings) -> Timings {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod written_check_tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_with_an_unwritten_pixel_is_refused_and_the_first_one_named() {
+        let mut color = vec![[0.5, 0.5, 0.5, 1.0]; 12];
+        assert!(check_every_pixel_written(&color, 4).is_ok());
+        // Alpha 0 is what the clear leaves; a written pixel of zero light still has alpha 1.
+        color[0] = [0.0, 0.0, 0.0, 1.0];
+        assert!(check_every_pixel_written(&color, 4).is_ok());
+        color[6] = [0.5, 0.5, 0.5, 0.0];
+        color[9] = [0.0; 4];
+        match check_every_pixel_written(&color, 4) {
+            Err(GpuError::DroppedWork {
+                unwritten,
+                total,
+                x,
+                y,
+                ..
+            }) => assert_eq!((unwritten, total, x, y), (2, 12, 2, 1)),
+            other => panic!("expected DroppedWork, got {other:?}"),
+        }
+    }
 }
