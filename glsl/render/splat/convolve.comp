@@ -12,6 +12,10 @@
 // kernel offset of the local pinhole scale; off axis, the kernels of the four field nodes
 // around the fragment, mixed bilinearly (glsl/common/field.glsl).
 #extension GL_GOOGLE_include_directive : require
+// Every constant-count loop is unrolled: lavapipe's shader compiler caps the iterations of all
+// loops of one invocation together at 65535 and silently stops the rest, leaving pixels
+// unwritten on long tile lists (off axis the four-node and per-pixel loops ran per fragment).
+#extension GL_EXT_control_flow_attributes : require
 #define FRAME_BINDING 10
 #include "splat.glsl"
 #include "band.glsl"
@@ -76,7 +80,7 @@ vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
         vec3 b = mix(s1, s2, step(0.5, i0));
         w = mix(a, b, t);
     } else {
-        for (int c = 0; c < 3; c++) {
+        [[unroll]] for (int c = 0; c < 3; c++) {
             float a = kernel_rgb(d, lo[c], f.index, origin)[c];
             w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, origin)[c], t[c]) : a;
         }
@@ -94,7 +98,7 @@ vec3 fragment_weight(uint j, Fragment f, vec2 d) {
         w = vec3(0.0);
         uvec4 nodes = batch_nodes[j];
         vec4 weights = batch_node_weights[j];
-        for (uint k = 0u; k < 4u; k++) {
+        [[unroll]] for (uint k = 0u; k < 4u; k++) {
             if (weights[k] > 0.0) {
                 w += weights[k] * kernel_at(f, d, node_origin(nodes[k]));
             }
@@ -147,7 +151,7 @@ void main() {
     vec3 Ag[PIXELS];
     vec3 Gg[PIXELS];     // the open group's weight of light that reaches the pupil
     float last[PIXELS];  // vergence of the last fragment that reached the pixel (−1: none)
-    for (uint q = 0u; q < PIXELS; q++) {
+    [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
         uvec2 pixel = uvec2(tx, ty) * TILE + gl_LocalInvocationID.xy + 8u * uvec2(q % PER_AXIS, q / PER_AXIS);
         centre[q] = vec2(pixel) + 0.5;
         C[q] = vec3(0.0);
@@ -184,7 +188,7 @@ void main() {
         uint batch_size = min(64u, n - start);
         for (uint j = 0u; j < batch_size; j++) {
             vec4 g = batch_reach[j];
-            for (uint q = 0u; q < PIXELS; q++) {
+            [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
                 if (abs(d.x) > g.z || abs(d.y) > g.z) {
                     continue;
@@ -216,7 +220,7 @@ void main() {
         // closed groups (or by the per-fragment blend), what lies behind adds at most ε of its
         // light; the open group is not closed yet and may still grow, so it does not count.
         bool saturated = true;
-        for (uint q = 0u; q < PIXELS; q++) {
+        [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
             saturated = saturated && all(greaterThanEqual(A[q], vec3(1.0 - frame.saturation_epsilon)));
         }
         if (!saturated || frame.saturation_epsilon <= 0.0) {
@@ -230,7 +234,7 @@ void main() {
         }
     }
 
-    for (uint q = 0u; q < PIXELS; q++) {
+    [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
         close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
         uvec2 pixel = uvec2(centre[q]);
         if (pixel.x < frame.width && pixel.y < frame.height) {
