@@ -127,6 +127,8 @@ pub struct DeviceInfo {
     pub vulkan_version: String,
     pub driver: String,
     pub device_local_mib: u64,
+    /// The largest single memory allocation the device allows (`maxMemoryAllocationSize`).
+    pub max_allocation_mib: u64,
     /// Why ocular cannot use it, if it cannot.
     pub unsuitable: Option<String>,
 }
@@ -351,11 +353,15 @@ fn version_string(v: u32) -> String {
 
 fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice) -> DeviceInfo {
     // SAFETY: `physical` comes from this instance's enumeration.
-    let (props, driver, memory, families) = unsafe {
+    let (props, driver, memory, families, max_allocation) = unsafe {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
+        let mut props2 = vk::PhysicalDeviceProperties2::default()
+            .push_next(&mut driver)
+            .push_next(&mut maintenance3);
         instance.get_physical_device_properties2(physical, &mut props2);
         let props = props2.properties;
+        let max_allocation = maintenance3.max_memory_allocation_size;
         let driver_name = driver
             .driver_info_as_c_str()
             .ok()
@@ -370,7 +376,7 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
             .unwrap_or_default();
         let memory = instance.get_physical_device_memory_properties(physical);
         let families = instance.get_physical_device_queue_family_properties(physical);
-        (props, driver_name, memory, families)
+        (props, driver_name, memory, families, max_allocation)
     };
     let name = props
         .device_name_as_c_str()
@@ -398,6 +404,7 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
         vulkan_version: version_string(props.api_version),
         driver,
         device_local_mib: device_local / (1024 * 1024),
+        max_allocation_mib: max_allocation / (1024 * 1024),
         unsuitable,
     }
 }

@@ -13,8 +13,21 @@ use crate::psf::kernels::{level_count, GridBlend, KernelGrid};
 /// border is for a single tile.
 const TILE_MARGIN: u32 = 1;
 
-/// Largest off-axis PSF texture (bytes): device memory stays bounded whatever the lattice.
-pub(super) const MAX_FIELD_TEXTURE_BYTES: u64 = 2 << 30;
+/// The off-axis PSF texture may always take this much (bytes), where one allocation can hold
+/// it: lavapipe's whole heap, and what every earlier release allowed.
+const FIELD_TEXTURE_FLOOR_BYTES: u64 = 2 << 30;
+
+/// Largest off-axis PSF texture (bytes) on a device with `device_local_bytes` of local memory
+/// and `max_allocation_bytes` per allocation: a quarter of the local memory (the frame's lists
+/// and images need the rest), never less than [`FIELD_TEXTURE_FLOOR_BYTES`], and never more
+/// than one allocation. Memory stays bounded whatever the lattice, and a large GPU is not held
+/// to a small one's budget (an H100's 80 GiB took the astigmatic eye's 3.5 GiB texture, which
+/// a fixed 2 GiB refused).
+pub(super) fn field_texture_limit_bytes(device_local_bytes: u64, max_allocation_bytes: u64) -> u64 {
+    (device_local_bytes / 4)
+        .max(FIELD_TEXTURE_FLOOR_BYTES)
+        .min(max_allocation_bytes)
+}
 
 /// Where each node's kernels lie in the PSF texture.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,19 +80,23 @@ impl TextureLayout {
     }
 
     /// A texture this device can create: every side within its 3D-image limit, and off axis
-    /// no larger than [`MAX_FIELD_TEXTURE_BYTES`].
+    /// no larger than [`field_texture_limit_bytes`].
     pub fn check(&self, ctx: &Context, texel_bytes: u64) -> crate::Result<()> {
         let bytes = self.bytes(texel_bytes);
-        if self.nodes != [1, 1] && bytes > MAX_FIELD_TEXTURE_BYTES {
+        let info = ctx.device_info();
+        let limit =
+            field_texture_limit_bytes(info.device_local_mib << 20, info.max_allocation_mib << 20);
+        if self.nodes != [1, 1] && bytes > limit {
             return Err(crate::Error::input(format!(
                 "--off-axis: the PSF texture for {} × {} field nodes with kernels up to {} px \
-                 would take {} MiB, over the {} MiB allowed; lower the largest radius (smaller \
+                 would take {} MiB, over the {} MiB this device allows (a quarter of its memory, \
+                 at least 2048 MiB, at most one allocation); lower the largest radius (smaller \
                  pupil, field of view or resolution)",
                 self.nodes[0],
                 self.nodes[1],
                 (self.pitch - 2 * self.margin - 1) / 2,
                 bytes >> 20,
-                MAX_FIELD_TEXTURE_BYTES >> 20
+                limit >> 20
             )));
         }
         let limit = ctx.limits().max_image_dimension3_d;
@@ -178,5 +195,20 @@ mod tests {
         // node 3 = h index 1, v index 1
         assert_eq!(layout.tile_code(3), 1 | (1 << 10) | (1 << 20));
         assert_eq!(layout.tile_code(4), 2 | (1 << 20));
+    }
+
+    #[test]
+    fn the_field_texture_bound_follows_the_device() {
+        const GIB: u64 = 1 << 30;
+        // lavapipe: a 2 GiB heap that one allocation may fill keeps the 2 GiB of before.
+        assert_eq!(field_texture_limit_bytes(2 * GIB, 2 * GIB), 2 * GIB);
+        // An 80 GiB GPU: a quarter of its memory, so the astigmatic eye's 3.5 GiB fits.
+        assert_eq!(field_texture_limit_bytes(80 * GIB, u64::MAX), 20 * GIB);
+        assert!(field_texture_limit_bytes(80 * GIB, u64::MAX) > 3577 << 20);
+        // Never past one allocation, even where the floor or the quarter would allow it.
+        assert_eq!(field_texture_limit_bytes(80 * GIB, 4 * GIB), 4 * GIB);
+        assert_eq!(field_texture_limit_bytes(GIB, GIB / 2), GIB / 2);
+        // A small GPU gets the floor, not a quarter of its memory.
+        assert_eq!(field_texture_limit_bytes(4 * GIB, 8 * GIB), 2 * GIB);
     }
 }
