@@ -1,6 +1,7 @@
 //! The runtime as an engine: a steady-state frame is one queue submission with no allocation
-//! and reads back only its image and two list sizes; a frame whose lists outgrow the buffer
-//! falls back to planned bands with the same image; the PSF texture is rebuilt only when the
+//! and reads back only its image and the band table's header (band count, status, list total,
+//! live fragments), banded frames included (bands planned on the GPU); a frame whose lists
+//! outgrow the buffer falls back to host-planned bands with the same image; the PSF texture is rebuilt only when the
 //! eye's state changes; the convolution's early exit changes the image by less than its ε.
 
 mod common;
@@ -113,7 +114,11 @@ fn steady_frames_are_one_submission_without_allocations() {
             next.stats.commands
         );
         let image_bytes = u64::from(W * H) * 16;
-        assert_eq!(next.stats.readback_bytes, image_bytes + 8);
+        assert_eq!(
+            next.stats.readback_bytes,
+            image_bytes + 16,
+            "image and band header"
+        );
         // the pixels, the radii, the field table (its header and one node's radii) and the
         // frame's uniforms
         assert!(
@@ -166,6 +171,72 @@ fn a_frame_that_outgrows_the_lists_falls_back_to_bands() {
     let expected = render(&mut fresh, &blurred, VIEW);
     assert_eq!(grown.color, expected.color);
     drop((splatter, fresh));
+    common::finish(ctx);
+}
+
+/// A frame whose lists need several bands is still one submission once steady: the bands are
+/// planned on the GPU from the prefix sum, into as many slots as the last frame needed plus a
+/// spare, and the image is the one the host-planned bands and a single band give, to the bit.
+/// Lists that outgrow the slots (more bands than recorded) fall back to the host's plan.
+#[test]
+fn banded_steady_frames_are_one_submission() {
+    let ctx = common::gpu();
+    let blurred = Frame::new(|x, y| (textured(x, y), 0.2)); // 5 D from focus: long lists
+    let sharp = Frame::new(|x, y| (textured(x, y), 2.0)); // 0.5 D: at focus, short lists
+    let mut whole = Splatter::new(&ctx, grid(), SplatSettings::default()).unwrap();
+    let expected = render(&mut whole, &blurred, VIEW);
+    assert_eq!(expected.stats.bands, 1);
+    let entries = expected.stats.list_entries;
+    // A list budget of a quarter of the frame's lists: four or five bands.
+    let banded_settings = SplatSettings {
+        max_list_bytes: entries * 8 / 4,
+        ..SplatSettings::default()
+    };
+    let mut banded = Splatter::new(&ctx, grid(), banded_settings).unwrap();
+    let first = render(&mut banded, &blurred, VIEW);
+    eprintln!("first banded frame: {:?}", first.stats);
+    assert!(first.stats.bands >= 4, "{} bands", first.stats.bands);
+    assert_eq!(first.stats.submissions, 2, "planning frame");
+    assert_eq!(
+        first.color, expected.color,
+        "host-planned bands change the image"
+    );
+    for _ in 0..2 {
+        let next = render(&mut banded, &blurred, VIEW);
+        eprintln!("steady banded frame: {:?}", next.stats);
+        assert_eq!(next.stats.submissions, 1);
+        assert_eq!(next.stats.allocations, 0);
+        assert_eq!(next.stats.bands, first.stats.bands);
+        assert_eq!(next.stats.list_entries, entries);
+        let image_bytes = u64::from(W * H) * 16;
+        assert_eq!(next.stats.readback_bytes, image_bytes + 16);
+        assert_eq!(
+            next.color, expected.color,
+            "GPU-planned bands change the image"
+        );
+    }
+    // A sharp frame needs fewer bands than the slots: still one submission, and the image of
+    // a fresh splatter.
+    let short = render(&mut banded, &sharp, VIEW);
+    eprintln!("sharp frame: {:?}", short.stats);
+    assert_eq!(short.stats.submissions, 1);
+    assert!(
+        short.stats.bands + 1 < first.stats.bands,
+        "{:?}",
+        short.stats
+    );
+    let mut fresh = Splatter::new(&ctx, grid(), SplatSettings::default()).unwrap();
+    assert_eq!(short.color, render(&mut fresh, &sharp, VIEW).color);
+    // Back to the blurred frame: more bands than the sharp frame's slots (its bands and a
+    // spare), so the GPU's plan is incomplete and the frame is planned on the host.
+    let regrown = render(&mut banded, &blurred, VIEW);
+    eprintln!("regrown banded frame: {:?}", regrown.stats);
+    assert_eq!(
+        regrown.stats.submissions, 3,
+        "one try, then host-planned bands"
+    );
+    assert_eq!(regrown.color, expected.color);
+    drop((whole, banded, fresh));
     common::finish(ctx);
 }
 
@@ -339,7 +410,11 @@ fn a_steady_scene_frame_is_one_submission_and_uploads_no_pixels() {
         assert_eq!(next.stats.submission_objects, 0);
         assert!(next.stats.upload_bytes <= UPLOAD_BOUND);
         let image_bytes = u64::from(SCENE_W * SCENE_H) * 16;
-        assert_eq!(next.stats.readback_bytes, image_bytes + 8);
+        assert_eq!(
+            next.stats.readback_bytes,
+            image_bytes + 16,
+            "image and band header"
+        );
         let passes: Vec<&str> = next
             .timings
             .passes

@@ -174,7 +174,11 @@ fn a_steady_peeled_frame_is_one_submission_and_moves_no_layer() {
         // more live fragments than pixels: the hidden layer's are in the stack
         assert!(next.stats.live_fragments > u64::from(W * H));
         assert!(next.stats.upload_bytes <= UPLOAD_BOUND);
-        assert_eq!(next.stats.readback_bytes, image_bytes + 8);
+        assert_eq!(
+            next.stats.readback_bytes,
+            image_bytes + 16,
+            "image and band header"
+        );
         assert_eq!(next.color, first.color);
     }
     // The host round trip: per layer a draw and a read-back, per later layer an upload of the

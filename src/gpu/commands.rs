@@ -526,6 +526,12 @@ impl<'a> Recorder<'a> {
         args: &Buffer,
         offset: u64,
     ) -> GpuResult<()> {
+        if let Some(open) = &self.render_pass_open {
+            return Err(GpuError::Usage {
+                pass: pipeline.name.clone(),
+                message: format!("dispatch inside the render pass of \"{open}\""),
+            });
+        }
         self.bind(
             &pipeline.parts(),
             bindings,

@@ -16,14 +16,15 @@
 // loops of one invocation together at 65535 and silently stops the rest, leaving pixels
 // unwritten on long tile lists (off axis the four-node and per-pixel loops ran per fragment).
 #extension GL_EXT_control_flow_attributes : require
-#define FRAME_BINDING 10
+#define FRAME_BINDING 11
+#define BANDS_BINDING 7
 #include "splat.glsl"
 #include "band.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
-FRAGMENT_BUFFERS(1, 7, 8, 9, readonly)
+FRAGMENT_BUFFERS(1, 8, 9, 10, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 3) readonly buffer Offsets { uint offsets[]; };
@@ -131,6 +132,7 @@ void close_group(inout vec3 C, inout vec3 A, inout vec3 Cg, inout vec3 Ag, inout
 }
 
 void main() {
+    load_band();
     uint tile = band.first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
     if (tile >= band.end_tile) {
         return;

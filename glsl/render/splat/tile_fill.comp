@@ -3,19 +3,24 @@
 // reach, at the tile's offset from the prefix sum. The fill order depends on scheduling; the
 // sort pass makes the lists deterministic.
 #extension GL_GOOGLE_include_directive : require
-#define FRAME_BINDING 7
+#define FRAME_BINDING 8
+#define BANDS_BINDING 4
 #include "splat.glsl"
 #include "band.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-FRAGMENT_BUFFERS(0, 4, 5, 6, readonly)
+FRAGMENT_BUFFERS(0, 5, 6, 7, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 2) buffer Cursors { uint cursors[]; };
 layout(std430, binding = 3) writeonly buffer Entries { uvec2 entries[]; };
 
 void main() {
+    load_band();
+    if (band.first_tile >= band.end_tile) {
+        return; // an empty slot of the band table
+    }
     uvec2 p = gl_GlobalInvocationID.xy;
     if (p.x >= frame.width || p.y >= frame.height * frame.layers) {
         return;

@@ -5,6 +5,7 @@
 // every comparator touching the padding can be skipped. Lists up to 2048 entries sort in
 // shared memory; longer ones sort in place in global memory (slower, but nothing is dropped).
 #extension GL_GOOGLE_include_directive : require
+#define BANDS_BINDING 3
 #include "band.glsl"
 
 layout(local_size_x = 256) in;
@@ -21,6 +22,7 @@ const uint RANK_SORT_LIMIT = 512u;
 shared uvec2 keys[SHARED_CAPACITY];
 
 void main() {
+    load_band();
     uint tile = band.first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
     if (tile >= band.end_tile) {
         return; // whole workgroup: no barrier is skipped by some threads only

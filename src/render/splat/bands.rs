@@ -13,32 +13,57 @@ pub(crate) struct Band {
     pub entries: u64,
 }
 
-/// Push constants of the list passes (tile fill, tile sort, convolve): the band they work on.
-/// Mirrors `BandPush` in glsl/common/band.glsl.
+/// Push constants of the list passes (tile fill, tile sort, convolve): which slot of the band
+/// table they work on. Mirrors `BandPush` in glsl/common/band.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct BandPush {
-    pub first_tile: u32,
-    pub end_tile: u32,
-    /// Global list offset of the band's first entry.
-    pub first_entry: u32,
+    pub slot: u32,
     /// Entries the list buffer holds: lists past it are not touched (the host re-plans).
     pub entry_capacity: u32,
 }
 
-impl BandPush {
-    /// The whole frame as one band.
-    pub fn whole_frame(tiles: u32, entry_capacity: u32) -> BandPush {
-        BandPush {
-            first_tile: 0,
-            end_tile: tiles,
-            first_entry: 0,
-            entry_capacity,
+/// The band table the GPU plans (glsl/render/splat/band_plan.comp): a 16-byte header (band
+/// count, status, total entries, live fragments), then 32 bytes per slot, the band's range and
+/// the indirect dispatch of the per-tile passes.
+pub(crate) const BAND_TABLE_HEADER_BYTES: u64 = 16;
+const BAND_SLOT_BYTES: u64 = 32;
+
+/// Bytes of a band table with `slots` slots.
+pub(crate) fn band_table_bytes(slots: u32) -> u64 {
+    BAND_TABLE_HEADER_BYTES + u64::from(slots) * BAND_SLOT_BYTES
+}
+
+/// Where slot `slot`'s indirect dispatch (three u32) lies in the band table.
+pub(crate) fn dispatch_offset(slot: u32) -> u64 {
+    BAND_TABLE_HEADER_BYTES + u64::from(slot) * BAND_SLOT_BYTES + 16
+}
+
+/// The band table's header as the host reads it back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct PlannedBands {
+    /// Bands the frame needs at the list buffer's size.
+    pub bands: u32,
+    /// 0: every tile lies in a recorded slot; 1: more bands than slots; 2: one row of tiles
+    /// needs more entries than the list buffer holds.
+    pub status: u32,
+    pub total_entries: u32,
+    pub live_fragments: u32,
+}
+
+impl PlannedBands {
+    pub fn from_header(header: &[u32]) -> PlannedBands {
+        PlannedBands {
+            bands: header[0],
+            status: header[1],
+            total_entries: header[2],
+            live_fragments: header[3],
         }
     }
 
-    pub fn tiles(&self) -> u32 {
-        self.end_tile - self.first_tile
+    /// Every band was recorded: the frame is complete.
+    pub fn complete(&self) -> bool {
+        self.status == 0
     }
 }
 

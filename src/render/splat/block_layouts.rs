@@ -3,6 +3,7 @@
 //! offset, and the block's size. Pipelines check sizes when they are built; this also catches
 //! two members swapped or renamed on one side only.
 
+use super::band_plan::BandPlanPush;
 use super::bands::BandPush;
 use super::fragments::FragmentsPush;
 use super::input::InputPush;
@@ -49,9 +50,7 @@ fn frame_uniform() -> BlockLayout {
 
 fn band_push() -> BlockLayout {
     layout_of!(BandPush {
-        first_tile,
-        end_tile,
-        first_entry,
+        slot,
         entry_capacity
     })
 }
@@ -118,7 +117,7 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "tile fill",
             RENDER_SPLAT_TILE_FILL_COMP,
-            Some(7),
+            Some(8),
             Some(band_push()),
         ),
         (
@@ -130,8 +129,19 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "convolve",
             RENDER_SPLAT_CONVOLVE_COMP,
-            Some(10),
+            Some(11),
             Some(band_push()),
+        ),
+        (
+            "band plan",
+            RENDER_SPLAT_BAND_PLAN_COMP,
+            None,
+            Some(layout_of!(BandPlanPush {
+                tiles_x,
+                tiles,
+                capacity,
+                slots
+            })),
         ),
     ]
 }
@@ -165,6 +175,6 @@ fn a_swapped_member_is_seen() {
     swapped.members[0].1 = b;
     swapped.members[1].1 = a;
     let r = reflect(crate::shaders::RENDER_SPLAT_TILE_SORT_COMP).unwrap();
-    assert_eq!(r.push_constants.as_ref().map(|p| p.bytes), Some(16));
+    assert_eq!(r.push_constants.as_ref().map(|p| p.bytes), Some(8));
     assert_ne!(r.push_constants, Some(swapped));
 }

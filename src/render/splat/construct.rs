@@ -1,10 +1,11 @@
 //! Building a splatter: the kernels resident on the GPU (on axis one grid, off axis one per
 //! field node), the PSF texture's layout, every pass, and the per-frame resources.
 
+use super::bands::{band_table_bytes, BAND_TABLE_HEADER_BYTES};
 use super::{
-    binding_limit, convolve, field, fragments, input, merge, prefix_sum, psf_texture, tile_count,
-    tile_fill, tile_sort, FrameResources, PsfTextureFormat, SplatSettings, Splatter,
-    FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
+    band_header_at, band_plan, binding_limit, convolve, field, fragments, input, merge, prefix_sum,
+    psf_texture, tile_count, tile_fill, tile_sort, FrameResources, PsfTextureFormat, SplatSettings,
+    Splatter, FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
 };
 use crate::gpu::{
     Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat,
@@ -128,6 +129,7 @@ impl Splatter {
             prefix_sum: prefix_sum::PrefixSumPass::new(ctx)?,
             tile_fill: tile_fill::TileFillPass::new(ctx)?,
             tile_sort: tile_sort::TileSortPass::new(ctx)?,
+            band_plan: band_plan::BandPlanPass::new(ctx)?,
             convolve: convolve::ConvolvePass::new(ctx, settings.tile_size, off_axis)?,
             grid,
         })
@@ -229,10 +231,17 @@ impl Splatter {
                 pixels / u64::from(layers) * 16,
                 Residency::Readback,
             )?,
+            // At most one band per tile row, plus the spare slot of a banded steady frame.
+            band_table: Buffer::new(
+                ctx,
+                "band table",
+                band_table_bytes(tiles_y + 1),
+                Residency::Device,
+            )?,
             readback_lists: Buffer::new(
                 ctx,
                 "list sizes read-back",
-                2 * (tiles + 1) * 4,
+                band_header_at(tiles) + BAND_TABLE_HEADER_BYTES,
                 Residency::Readback,
             )?,
         });

@@ -5,9 +5,8 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Sampler,
 };
 
-use super::bands::BandPush;
+use super::bands::{dispatch_offset, BandPush};
 use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::tile_fill::per_tile_groups;
 use super::{FrameBlock, FrameUniform};
 
 pub(super) struct ConvolvePass {
@@ -27,6 +26,7 @@ impl ConvolvePass {
                         BindingKind::StorageBuffer,
                         BindingKind::StorageImage,
                         BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
                     ],
                 ))
                 .uniform::<FrameUniform>()
@@ -43,6 +43,7 @@ impl ConvolvePass {
         rec: &mut Recorder<'_>,
         frame: FrameBlock<'_>,
         band: &BandPush,
+        bands: &Buffer,
         psf: (&Image, &Sampler),
         field_table: &Buffer,
         fragments: &FragmentStore,
@@ -59,14 +60,16 @@ impl ConvolvePass {
                 Binding::Buffer(entries),
                 Binding::Storage(output),
                 Binding::Buffer(field_table),
+                Binding::Buffer(bands),
             ],
         );
         bindings.push(frame.binding());
-        rec.dispatch(
+        rec.dispatch_indirect(
             &self.pipeline,
             &bindings,
             band,
-            per_tile_groups(band.tiles()),
+            bands,
+            dispatch_offset(band.slot),
         )
     }
 }

@@ -1,10 +1,12 @@
 //! Tiled PSF splatting on the GPU (Csoba & Kunkli 2021, after Franke et al. 2018).
 //!
 //! Per frame: PSF texture (blend the kernel grid over pupil and focus) → fragments (one per
-//! pixel) → merge (optional 2×2 / 4×4 blocks) → tile count → prefix sum → [per band of tile
-//! rows: fill → sort → convolve]. List memory is exact (count → prefix sum → fill); when a
-//! frame's lists exceed the device's storage-buffer binding limit or the memory budget, the
-//! screen is processed in bands of tile rows, so nothing is ever dropped.
+//! pixel) → merge (optional 2×2 / 4×4 blocks) → tile count → prefix sum → band plan → [per
+//! band of tile rows: fill → sort → convolve]. List memory is exact (count → prefix sum →
+//! fill); when a frame's lists exceed the list buffer (the device's storage-buffer binding
+//! limit or the memory budget), the screen is processed in bands of tile rows, planned on the
+//! GPU from the prefix sum, so nothing is ever dropped and a banded frame is still one
+//! submission.
 //!
 //! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`; `construct` builds a
 //! splatter, `settings` holds its options, `field` the off-axis lattice, `bands` the planning
@@ -12,6 +14,7 @@
 //! shares are in that block (one persistent buffer, written through its mapping); values that
 //! change between dispatches are each pass's own typed push constants.
 
+mod band_plan;
 mod bands;
 #[cfg(test)]
 mod block_layouts;
@@ -32,7 +35,7 @@ mod uniform;
 use crate::gpu::{Buffer, Context, GpuError, Image, Residency, Sampler, Timings};
 use crate::psf::kernels::KernelGrid;
 
-use bands::{plan_bands, BandPush};
+use bands::{plan_bands, BandPush, PlannedBands};
 pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
@@ -148,13 +151,16 @@ struct FrameResources {
     cursors: Buffer,
     offsets: Buffer,
     block_sums: Buffer,
+    /// The bands the GPU planned (glsl/render/splat/band_plan.comp) and their dispatches.
+    band_table: Buffer,
     /// The frame's `FrameUniform`, written through its mapping before each submission.
     uniform: Buffer,
     /// Persistent, mapped transfer buffers: host inputs in (made at the first host frame),
     /// the image and the list sizes out.
     staging: Option<input::Staging>,
     readback_color: Buffer,
-    /// counts (tiles + 1, the last = live fragments), then offsets (tiles + 1, the last = total).
+    /// counts (tiles + 1, the last = live fragments), offsets (tiles + 1, the last = total),
+    /// then the band table's header ([`band_header_at`]).
     readback_lists: Buffer,
 }
 
@@ -176,8 +182,9 @@ pub struct Splatter {
     radii_staging: Buffer,
     /// The blend the PSF texture holds (None: not built yet).
     texture_blend: Option<crate::psf::kernels::GridBlend>,
-    /// Lists of the last frame: total entries and bands (decides the one-submission path).
-    last_lists: Option<(u64, usize)>,
+    /// Lists of the last frame: total entries and bands (decides the one-submission path and
+    /// its band slots).
+    last_lists: Option<(u64, u32)>,
     /// Per set, the core radius of every object's kernels (see `KernelSet::core_radii_px`).
     core_radii: Vec<Vec<[f32; 3]>>,
     frame: Option<FrameResources>,
@@ -190,6 +197,7 @@ pub struct Splatter {
     prefix_sum: prefix_sum::PrefixSumPass,
     tile_fill: tile_fill::TileFillPass,
     tile_sort: tile_sort::TileSortPass,
+    band_plan: band_plan::BandPlanPass,
     convolve: convolve::ConvolvePass,
 }
 
@@ -198,6 +206,17 @@ pub const MAX_OFF_AXIS_TILE: u32 = 16;
 
 pub(super) const FRAGMENT_BYTES: u64 = std::mem::size_of::<Fragment>() as u64;
 const ENTRY_BYTES: u64 = 8;
+
+/// Where the band table's header lies in the list-sizes read-back of a frame of `tiles` tiles.
+pub(super) fn band_header_at(tiles: u64) -> u64 {
+    2 * (tiles + 1) * 4
+}
+
+/// Band slots a steady frame records after a frame of `bands` bands: as many, and one spare
+/// when the frame is banded (lists that grow a little may need one more).
+fn steady_slots(bands: u32) -> u32 {
+    bands + u32::from(bands > 1)
+}
 
 pub(super) fn binding_limit(ctx: &Context) -> u64 {
     u64::from(ctx.limits().max_storage_buffer_range)
@@ -305,59 +324,54 @@ impl Splatter {
         let output_bytes = pixels as u64 * 16;
 
         // Steady state: the whole frame in one submission, with the list buffer of earlier
-        // frames; only the list total comes back, and a frame whose lists outgrew the buffer
-        // (or need bands) is rendered again below, in bands.
+        // frames and as many band slots as the last frame needed (one spare when banded); the
+        // bands are planned on the GPU and only the band table's header comes back. A frame
+        // whose lists outgrew the buffer or the slots is rendered again below, planned on the
+        // host.
         let one_submission = !keep_intermediates
             && self.settings.steady_state
             && self.entries.is_some()
-            && self.last_lists.is_some_and(|(_, bands)| bands == 1);
+            && self.last_lists.is_some();
+        let header_at = band_header_at(u64::from(tiles));
         let mut submissions = 0u32;
         let mut sync = (0u32, 0u32);
         if one_submission {
             let entries = self.entries.as_ref().expect("checked above");
-            let band = BandPush::whole_frame(tiles, entries_in(entries));
+            let slots = steady_slots(self.last_lists.map_or(1, |(_, bands)| bands));
             let timings = ctx.submit(|rec| {
                 let texture = rebuild_texture.then_some(&blend);
                 self.record_front(rec, &source, frame, block, texture, hidden)?;
+                self.record_bands(rec, frame, block, slots, entries)?;
                 rec.copy_buffer_region(
-                    &frame.counts,
-                    u64::from(tiles) * 4,
+                    &frame.band_table,
+                    0,
                     &frame.readback_lists,
-                    u64::from(tiles) * 4,
-                    4,
+                    header_at,
+                    bands::BAND_TABLE_HEADER_BYTES,
                 );
-                rec.copy_buffer_region(
-                    &frame.offsets,
-                    u64::from(tiles) * 4,
-                    &frame.readback_lists,
-                    u64::from(2 * tiles + 1) * 4,
-                    4,
-                );
-                self.record_band(rec, frame, block, &band, entries)?;
                 rec.end_pass();
                 rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
                 sync = rec.barrier_counts();
                 Ok(())
             })?;
             submissions += 1;
-            let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
-            let (live, total) = (sizes[tiles as usize], sizes[2 * tiles as usize + 1]);
-            if total <= band.entry_capacity {
+            let planned = read_band_header(&frame.readback_lists, header_at);
+            if planned.complete() {
                 self.texture_blend = Some(blend);
-                self.last_lists = Some((u64::from(total), 1));
+                self.last_lists = Some((u64::from(planned.total_entries), planned.bands));
                 let stats = SplatStats {
                     fragments: pixels as u64,
-                    live_fragments: u64::from(live),
-                    list_entries: u64::from(total),
+                    live_fragments: u64::from(planned.live_fragments),
+                    list_entries: u64::from(planned.total_entries),
                     max_entries_per_tile: 0,
-                    bands: 1,
+                    bands: planned.bands,
                     submissions,
                     allocations: (ctx.allocations() - allocations_before) as u32,
                     submission_objects: ctx.submission_objects_created() - objects_before,
                     barriers: sync.0,
                     commands: sync.1,
                     upload_bytes,
-                    readback_bytes: output_bytes + 8,
+                    readback_bytes: output_bytes + bands::BAND_TABLE_HEADER_BYTES,
                 };
                 let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
                 check_every_pixel_written(&color, w as usize)?;
@@ -370,7 +384,8 @@ impl Splatter {
             }
         }
 
-        // Planning frame: everything up to the exact list sizes, read back to plan bands.
+        // Planning frame: everything up to the exact list sizes, read back to size the list
+        // buffer and count the bands; the GPU then plans the same bands (checked below).
         let mut timings = ctx.submit(|rec| {
             self.record_front(rec, &source, frame, block, Some(&blend), hidden)?;
             rec.end_pass();
@@ -396,7 +411,7 @@ impl Splatter {
         let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
         let counts = sizes[..tiles as usize].to_vec();
         let live = u64::from(sizes[tiles as usize]);
-        let offsets = sizes[tiles as usize + 1..].to_vec();
+        let offsets = sizes[tiles as usize + 1..2 * (tiles as usize + 1)].to_vec();
         let total: u64 = counts.iter().map(|&c| u64::from(c)).sum();
         if total != u64::from(offsets[tiles as usize]) {
             return Err(GpuError::Usage {
@@ -408,8 +423,11 @@ impl Splatter {
             }
             .into());
         }
-        let bands = plan_bands(&counts, frame.tiles_x, self.list_capacity_entries())?;
-        let largest_band = bands.iter().map(|b| b.entries).max().unwrap_or(0);
+        let largest_band = plan_bands(&counts, frame.tiles_x, self.list_capacity_entries())?
+            .iter()
+            .map(|b| b.entries)
+            .max()
+            .unwrap_or(0);
         self.ensure_entries(largest_band)?;
         let frame = self.frame.as_ref().expect("ensured above");
         let block = FrameBlock {
@@ -417,16 +435,19 @@ impl Splatter {
             buffer: &frame.uniform,
         };
         let entries = self.entries.as_ref().expect("ensured above");
+        // The bands of the buffer actually made (it may hold more than the largest band, never
+        // less): the plan every later steady frame repeats on the GPU.
+        let bands = plan_bands(&counts, frame.tiles_x, u64::from(entries_in(entries)))?;
+        let slots = bands.len() as u32;
         let band_timings = ctx.submit(|rec| {
-            for band in &bands {
-                let push = BandPush {
-                    first_tile: band.first_tile,
-                    end_tile: band.end_tile,
-                    first_entry: band.first_entry,
-                    entry_capacity: entries_in(entries),
-                };
-                self.record_band(rec, frame, block, &push, entries)?;
-            }
+            self.record_bands(rec, frame, block, slots, entries)?;
+            rec.copy_buffer_region(
+                &frame.band_table,
+                0,
+                &frame.readback_lists,
+                header_at,
+                bands::BAND_TABLE_HEADER_BYTES,
+            );
             rec.end_pass();
             rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
             let (b, c) = rec.barrier_counts();
@@ -434,9 +455,20 @@ impl Splatter {
             Ok(())
         })?;
         submissions += 1;
+        let planned = read_band_header(&frame.readback_lists, header_at);
+        if !planned.complete() || planned.bands != slots {
+            return Err(GpuError::Usage {
+                pass: "band plan".into(),
+                message: format!(
+                    "the GPU planned {} band(s) (status {}), the host {slots}",
+                    planned.bands, planned.status
+                ),
+            }
+            .into());
+        }
         timings.extend(band_timings);
         self.texture_blend = Some(blend);
-        self.last_lists = Some((total, bands.len()));
+        self.last_lists = Some((total, slots));
         let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
         check_every_pixel_written(&color, w as usize)?;
         let stats = SplatStats {
@@ -444,18 +476,18 @@ impl Splatter {
             live_fragments: live,
             list_entries: total,
             max_entries_per_tile: counts.iter().copied().max().unwrap_or(0).into(),
-            bands: bands.len() as u32,
+            bands: slots,
             submissions,
             allocations: (ctx.allocations() - allocations_before) as u32,
             submission_objects: ctx.submission_objects_created() - objects_before,
             barriers: sync.0,
             commands: sync.1,
             upload_bytes,
-            readback_bytes: output_bytes + u64::from(2 * (tiles + 1)) * 4,
+            readback_bytes: output_bytes + header_at + bands::BAND_TABLE_HEADER_BYTES,
         };
         let intermediates = if keep_intermediates {
             let mut all_entries: Vec<[u32; 2]> = entries.read(&ctx)?;
-            all_entries.truncate(if bands.len() == 1 { total as usize } else { 0 });
+            all_entries.truncate(if slots == 1 { total as usize } else { 0 });
             let fragments: Vec<Fragment> = frame.fragments.buffer.read(&ctx)?;
             Some(SplatIntermediates {
                 fragments,
@@ -559,42 +591,70 @@ impl Splatter {
         Ok(())
     }
 
-    /// Records one band's list fill, sort and convolution.
-    fn record_band(
+    /// Records the band plan and `slots` bands' list fill, sort and convolution.
+    fn record_bands(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         frame: &FrameResources,
         block: FrameBlock<'_>,
-        band: &BandPush,
+        slots: u32,
         entries: &Buffer,
     ) -> crate::gpu::GpuResult<()> {
-        rec.begin_pass("tile fill");
-        rec.fill_buffer(&frame.cursors, 0);
-        self.tile_fill.record(
+        let entry_capacity = entries_in(entries);
+        rec.begin_pass("band plan");
+        self.band_plan.record(
             rec,
-            block,
-            band,
-            &frame.fragments,
-            &frame.offsets,
-            &frame.cursors,
-            entries,
-        )?;
-        rec.begin_pass("tile sort");
-        self.tile_sort
-            .record(rec, band, &frame.counts, &frame.offsets, entries)?;
-        rec.begin_pass("convolve");
-        self.convolve.record(
-            rec,
-            block,
-            band,
-            (&self.texture, &self.sampler),
-            &self.field_table.buffer,
-            &frame.fragments,
+            &band_plan::BandPlanPush {
+                tiles_x: frame.tiles_x,
+                tiles: frame.tiles_x * frame.tiles_y,
+                capacity: entry_capacity,
+                slots,
+            },
             &frame.counts,
             &frame.offsets,
-            entries,
-            &frame.color_out,
+            &frame.band_table,
         )?;
+        for slot in 0..slots {
+            let band = BandPush {
+                slot,
+                entry_capacity,
+            };
+            rec.begin_pass("tile fill");
+            rec.fill_buffer(&frame.cursors, 0);
+            self.tile_fill.record(
+                rec,
+                block,
+                &band,
+                &frame.band_table,
+                &frame.fragments,
+                &frame.offsets,
+                &frame.cursors,
+                entries,
+            )?;
+            rec.begin_pass("tile sort");
+            self.tile_sort.record(
+                rec,
+                &band,
+                &frame.band_table,
+                &frame.counts,
+                &frame.offsets,
+                entries,
+            )?;
+            rec.begin_pass("convolve");
+            self.convolve.record(
+                rec,
+                block,
+                &band,
+                &frame.band_table,
+                (&self.texture, &self.sampler),
+                &self.field_table.buffer,
+                &frame.fragments,
+                &frame.counts,
+                &frame.offsets,
+                entries,
+                &frame.color_out,
+            )?;
+        }
         Ok(())
     }
 
@@ -625,6 +685,17 @@ impl Splatter {
         )?);
         Ok(())
     }
+}
+
+/// The band table's header from the list-sizes read-back.
+fn read_band_header(readback: &Buffer, at: u64) -> PlannedBands {
+    let bytes = readback
+        .mapped_bytes()
+        .expect("read-back buffers are host-visible");
+    let at = at as usize;
+    let words: Vec<u32> =
+        bytemuck::pod_collect_to_vec(&bytes[at..at + bands::BAND_TABLE_HEADER_BYTES as usize]);
+    PlannedBands::from_header(&words)
 }
 
 /// Entries a list buffer holds.

@@ -21,6 +21,7 @@ impl TileFillPass {
                         BindingKind::StorageBuffer,
                         BindingKind::StorageBuffer,
                         BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
                     ],
                 ))
                 .uniform::<FrameUniform>()
@@ -29,13 +30,15 @@ impl TileFillPass {
         Ok(TileFillPass { pipeline })
     }
 
-    /// `cursors` must be zeroed; `entries` holds the band's lists.
+    /// `cursors` must be zeroed; `entries` holds the lists of the band in `band.slot` of
+    /// `bands` (the band table).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
         frame: FrameBlock<'_>,
         band: &BandPush,
+        bands: &Buffer,
         fragments: &FragmentStore,
         offsets: &Buffer,
         cursors: &Buffer,
@@ -47,6 +50,7 @@ impl TileFillPass {
                 Binding::Buffer(offsets),
                 Binding::Buffer(cursors),
                 Binding::Buffer(entries),
+                Binding::Buffer(bands),
             ],
         );
         bindings.push(frame.binding());
@@ -58,11 +62,4 @@ impl TileFillPass {
             [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
         )
     }
-}
-
-/// Workgroup grid with one workgroup per tile, folded into two dimensions past the per-axis
-/// dispatch limit (the shaders unfold it and skip the excess).
-pub(super) fn per_tile_groups(tiles: u32) -> [u32; 3] {
-    const AXIS: u32 = 65_535;
-    [tiles.clamp(1, AXIS), tiles.div_ceil(AXIS).max(1), 1]
 }

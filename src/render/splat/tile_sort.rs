@@ -3,8 +3,7 @@
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
-use super::bands::BandPush;
-use super::tile_fill::per_tile_groups;
+use super::bands::{dispatch_offset, BandPush};
 
 pub(super) struct TileSortPass {
     pipeline: ComputePipeline,
@@ -18,29 +17,35 @@ impl TileSortPass {
                     BindingKind::StorageBuffer,
                     BindingKind::StorageBuffer,
                     BindingKind::StorageBuffer,
+                    BindingKind::StorageBuffer,
                 ])
                 .push_constants::<BandPush>()
                 .build(ctx)?;
         Ok(TileSortPass { pipeline })
     }
 
+    /// One workgroup per tile of the band in `band.slot` of `bands`, dispatched as the band
+    /// table says.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
         band: &BandPush,
+        bands: &Buffer,
         counts: &Buffer,
         offsets: &Buffer,
         entries: &Buffer,
     ) -> GpuResult<()> {
-        rec.dispatch(
+        rec.dispatch_indirect(
             &self.pipeline,
             &[
                 Binding::Buffer(counts),
                 Binding::Buffer(offsets),
                 Binding::Buffer(entries),
+                Binding::Buffer(bands),
             ],
             band,
-            per_tile_groups(band.tiles()),
+            bands,
+            dispatch_offset(band.slot),
         )
     }
 }
