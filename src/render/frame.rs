@@ -236,9 +236,13 @@ fn prepare_field_kernels(
     Ok(PreparedKernels {
         grid: out.field.grids[nearest].clone(),
         plan,
-        // the nearest node's report, counting every node's PSFs
+        // the nearest node's report, counting every node's PSFs and time (the nodes are
+        // computed one after another, so their times add up to the wall time)
         report: out.reports.get(nearest).cloned().map(|mut r| {
             r.psfs_computed = out.reports.iter().map(|r| r.psfs_computed).sum();
+            r.seconds_optics = out.reports.iter().map(|r| r.seconds_optics).sum();
+            r.seconds_psfs = out.reports.iter().map(|r| r.seconds_psfs).sum();
+            r.seconds_kernels = out.reports.iter().map(|r| r.seconds_kernels).sum();
             r
         }),
         cache: out.cache,
