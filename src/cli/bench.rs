@@ -140,6 +140,8 @@ struct Report {
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 struct Counters {
     submissions: u32,
+    /// Bands of tile rows the frame's lists were processed in (1: the whole frame at once).
+    bands: u32,
     allocations: u32,
     /// Vulkan objects created for the frame's submissions (0: all reused).
     submission_objects: u64,
@@ -281,6 +283,7 @@ fn time_frames(
             t.list_entries = s.list_entries;
             t.counters = Counters {
                 submissions: s.submissions,
+                bands: s.bands,
                 // the device's own count: raster, splat and transfers alike
                 allocations,
                 submission_objects: s.submission_objects,
@@ -533,8 +536,8 @@ fn print_table(r: &Report) {
     );
     let c = &r.counters;
     println!(
-        "  per frame: {} submission(s), {} allocation(s), {} Vulkan object(s) created, {} barrier(s) for {} command(s), {} B up, {} B down",
-        c.submissions, c.allocations, c.submission_objects, c.barriers, c.commands, c.upload_bytes, c.readback_bytes
+        "  per frame: {} submission(s), {} band(s), {} allocation(s), {} Vulkan object(s) created, {} barrier(s) for {} command(s), {} B up, {} B down",
+        c.submissions, c.bands, c.allocations, c.submission_objects, c.barriers, c.commands, c.upload_bytes, c.readback_bytes
     );
     if let Some(b) = &r.baseline {
         println!();
