@@ -1,5 +1,8 @@
 //! Bands: when a frame's tile lists exceed what one binding (or the memory budget) holds, the
 //! screen is processed in bands of whole tile rows, planned from the exact per-tile counts.
+//! The GPU plans every frame's bands (glsl/render/splat/band_plan.comp, into the band table
+//! below); [`plan_bands`] is the same rule on the host, which sizes the list buffer and the
+//! slots of a frame the GPU could not plan, and whose band count the GPU's must then match.
 
 use super::ENTRY_BYTES;
 
