@@ -341,16 +341,7 @@ impl Splatter {
             let timings = ctx.submit(|rec| {
                 let texture = rebuild_texture.then_some(&blend);
                 self.record_front(rec, &source, frame, block, texture, hidden)?;
-                self.record_bands(rec, frame, block, slots, entries)?;
-                rec.copy_buffer_region(
-                    &frame.band_table,
-                    0,
-                    &frame.readback_lists,
-                    header_at,
-                    bands::BAND_TABLE_HEADER_BYTES,
-                );
-                rec.end_pass();
-                rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
+                self.record_back(rec, frame, block, slots, entries)?;
                 sync = rec.barrier_counts();
                 Ok(())
             })?;
@@ -440,16 +431,7 @@ impl Splatter {
         let bands = plan_bands(&counts, frame.tiles_x, u64::from(entries_in(entries)))?;
         let slots = bands.len() as u32;
         let band_timings = ctx.submit(|rec| {
-            self.record_bands(rec, frame, block, slots, entries)?;
-            rec.copy_buffer_region(
-                &frame.band_table,
-                0,
-                &frame.readback_lists,
-                header_at,
-                bands::BAND_TABLE_HEADER_BYTES,
-            );
-            rec.end_pass();
-            rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
+            self.record_back(rec, frame, block, slots, entries)?;
             let (b, c) = rec.barrier_counts();
             sync = (sync.0 + b, sync.1 + c);
             Ok(())
@@ -591,8 +573,9 @@ impl Splatter {
         Ok(())
     }
 
-    /// Records the band plan and `slots` bands' list fill, sort and convolution.
-    fn record_bands(
+    /// Records the passes after the prefix sum: the band plan, `slots` bands' list fill, sort
+    /// and convolution, and the read-back of the band table's header and the image.
+    fn record_back(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         frame: &FrameResources,
@@ -655,6 +638,15 @@ impl Splatter {
                 &frame.color_out,
             )?;
         }
+        rec.copy_buffer_region(
+            &frame.band_table,
+            0,
+            &frame.readback_lists,
+            band_header_at(u64::from(frame.tiles_x * frame.tiles_y)),
+            bands::BAND_TABLE_HEADER_BYTES,
+        );
+        rec.end_pass();
+        rec.copy_image_to_buffer(&frame.color_out, &frame.readback_color);
         Ok(())
     }
 
