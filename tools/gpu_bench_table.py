@@ -34,17 +34,17 @@ def passes(report):
 
 
 def table3(runs):
-    print("| scene | eye | size | Rmax px | list entries | GPU ms: total = raster + sort + "
-          "convolve + rest | wall ms (p95) | baseline: wall / GPU ms | wall, baseline ÷ this "
-          "| paper, TITAN Xp |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| scene | eye | size | Rmax px | list entries | submissions (bands) | GPU ms: total = "
+          "raster + sort + convolve + rest | wall ms (p95) | baseline: wall / GPU ms | wall, "
+          "baseline ÷ this | paper, TITAN Xp |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     sizes = sorted({(k[2], k[3]) for k in runs if not k[4]})
     for w, h in sizes:
         for scene in SCENES:
             for eye in EYES:
                 r = runs.get((scene, eye, w, h, False))
                 if r is None:
-                    print(f"| {scene} | {eye} | {w}×{h} | — | — | not run | — | — | — | — |")
+                    print(f"| {scene} | {eye} | {w}×{h} | — | — | — | not run | — | — | — | — |")
                     continue
                 p = passes(r)
                 total = r["total"]["mean_ms"]
@@ -58,8 +58,11 @@ def table3(runs):
                         if b else "—")
                 ratio = f"{b['speedup']:.2f}×" if b else "—"
                 paper = PAPER_720P if (w, h) == (1280, 720) else "—"
+                c = r["counters"]
+                # reports from before the GPU band plan carry no band count
+                bands = f" ({c['bands']})" if "bands" in c else ""
                 print(f"| {scene} | {eye} | {w}×{h} | {r['max_radius_px']} "
-                      f"| {r['list_entries'] / 1e6:.1f} M "
+                      f"| {r['list_entries'] / 1e6:.1f} M | {c['submissions']}{bands} "
                       f"| {total:.1f} = {raster:.1f} + {sort:.1f} + {conv:.1f} + {rest:.1f} "
                       f"| {wall['mean_ms']:.1f} ({wall['p95_ms']:.1f}) | {base} | {ratio} "
                       f"| {paper} |")
