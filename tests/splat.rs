@@ -9,7 +9,7 @@ use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::gpu::texture_probe::TextureProbe;
 use ocular::gpu::Context;
 use ocular::psf::kernels::{
-    kernel_side, level_block_radius, level_of_radius, DioptreAxis, KernelGrid,
+    kernel_side, level_block_radius, level_count, level_of_radius, DioptreAxis, KernelGrid,
 };
 use ocular::render::reference;
 use ocular::render::splat::{
@@ -171,32 +171,39 @@ fn psf_texture_matches_cpu_blend_of_four_grid_states() {
         let mut splatter = Splatter::new(&ctx, grid.clone(), settings).unwrap();
         splatter.render(&scene.input(), view, false).unwrap();
         let (image, sampler) = splatter.psf_texture();
-        let [w, h, d] = image.extent();
+        assert_eq!(
+            image.extent()[2] as usize,
+            objects.count,
+            "one layer per object"
+        );
+        // Every level's block and its ring of zeros, at every object distance, read texel by
+        // texel where the atlas says the block lies.
         let mut points = Vec::new();
-        for z in 0..d {
-            for y in 0..h {
-                for x in 0..w {
-                    points.push([x as f32 + 0.5, y as f32 + 0.5, z as f32 + 0.5]);
+        let mut wanted = Vec::new();
+        for level in 0..level_count(max_radius) {
+            let r = level_block_radius(level) as i64;
+            let [cx, cy] = splatter.psf_texture_centre(0, level);
+            for o in 0..objects.count {
+                for dy in -r - 1..=r + 1 {
+                    for dx in -r - 1..=r + 1 {
+                        let (x, y) = (cx as i64 + dx, cy as i64 + dy);
+                        points.push([x as f32 + 0.5, y as f32 + 0.5, o as f32 + 0.5]);
+                        wanted.push(if dx.abs() <= r && dy.abs() <= r {
+                            let side = kernel_side(r as u32);
+                            let texel = expected.kernel(level, o)
+                                [(dy + r) as usize * side + (dx + r) as usize];
+                            texel.map(|v| v * (side * side) as f32)
+                        } else {
+                            [0.0; 3]
+                        });
+                    }
                 }
             }
         }
         let probe = TextureProbe::new(&ctx).unwrap();
         let samples = probe.sample(&ctx, image, sampler, &points).unwrap();
-        let rmax = max_radius as i64;
         let mut worst = 0.0f32;
-        for (p, s) in points.iter().zip(&samples) {
-            let (x, y, z) = (p[0] as i64, p[1] as i64, p[2] as usize);
-            let (level, o) = ((z / objects.count) as u32, z % objects.count);
-            let r = level_block_radius(level);
-            let (dx, dy) = (x - rmax, y - rmax);
-            let want = if dx.abs() <= r as i64 && dy.abs() <= r as i64 {
-                let side = kernel_side(r);
-                let texel = expected.kernel(level, o)
-                    [(dy + r as i64) as usize * side + (dx + r as i64) as usize];
-                texel.map(|v| v * (side * side) as f32)
-            } else {
-                [0.0; 3]
-            };
+        for (want, s) in wanted.iter().zip(&samples) {
             for c in 0..3 {
                 worst = worst.max((want[c] - s[c]).abs() / want[c].abs().max(1.0));
             }

@@ -1,8 +1,8 @@
-// Off-axis kernels (src/render/splat/field.rs): the PSF texture holds one tile per node of a
-// lattice of field angles (h, v); a fragment's kernel mixes the four nodes around the direction
-// of its pixel. On axis the lattice is one node whose tile is the whole texture.
+// Off-axis kernels (src/render/splat/field.rs): the PSF texture holds one region per node of a
+// lattice of field angles (h, v) (glsl/common/atlas.glsl); a fragment's kernel mixes the four
+// nodes around the direction of its pixel. On axis the lattice is one node.
 // The including pass declares `field_header[2]` and `node_radii[]` (the Field buffer):
-//   field_header[0] = (nodes along h, nodes along v, tile pitch in texels, tile data offset),
+//   field_header[0] = (nodes along h, nodes along v, 0, 0),
 //   field_header[1] = (first h, h step, first v, v step) in degrees,
 //   node_radii[node · No + o] = the node's natural radius per channel at object distance o.
 #ifndef OCULAR_FIELD_GLSL
@@ -32,12 +32,6 @@ void field_corners(vec2 c, out uvec4 nodes, out vec4 weights) {
     uvec2 h = uvec2(hi);
     nodes = uvec4(l.x * nv + l.y, l.x * nv + h.y, h.x * nv + l.y, h.x * nv + h.y);
     weights = vec4((1.0 - f.x) * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * (1.0 - f.y), f.x * f.y);
-}
-
-// Texel origin of a node's tile in the PSF texture (its kernels are centred at origin + Rmax).
-vec2 node_origin(uint node) {
-    uint nv = uint(field_header[0].y);
-    return vec2(float(node / nv), float(node % nv)) * field_header[0].z + field_header[0].w;
 }
 
 #endif

@@ -128,6 +128,8 @@ struct Report {
     wall_ms_per_frame: Stat,
     list_entries: u64,
     max_radius_px: u32,
+    /// Device memory of the PSF texture (bytes).
+    psf_texture_bytes: u64,
     /// `--off-axis`: the field directions (degrees) the kernels were computed for.
     #[serde(skip_serializing_if = "Option::is_none")]
     field: Option<crate::psf::field::FieldAxes>,
@@ -167,6 +169,7 @@ struct TimedFrames {
     totals: Vec<f64>,
     walls: Vec<f64>,
     list_entries: u64,
+    psf_texture_bytes: u64,
     counters: Counters,
 }
 
@@ -258,6 +261,7 @@ fn time_frames(
         totals: Vec::with_capacity(args.frames),
         walls: Vec::with_capacity(args.frames),
         list_entries: 0,
+        psf_texture_bytes: 0,
         counters: Counters::default(),
     };
     for i in 0..args.warmup + args.frames {
@@ -281,6 +285,7 @@ fn time_frames(
         t.walls.push(wall_ms);
         if let Some(s) = out.stats {
             t.list_entries = s.list_entries;
+            t.psf_texture_bytes = s.psf_texture_bytes;
             t.counters = Counters {
                 submissions: s.submissions,
                 bands: s.bands,
@@ -407,6 +412,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         totals,
         walls,
         list_entries,
+        psf_texture_bytes,
         counters,
     } = timed;
     let splat_total = stat("total", &totals);
@@ -446,6 +452,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         wall_ms_per_frame: stat("wall", &walls),
         list_entries,
         max_radius_px,
+        psf_texture_bytes,
         field,
         counters,
         baseline,
@@ -486,8 +493,13 @@ fn print_table(r: &Report) {
         r.scene, r.eye, r.width, r.height, r.device, r.driver
     );
     println!(
-        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} depth layer(s), {} list entries/frame",
-        r.focus_d, r.pupil_mm, r.max_radius_px, r.layers, r.list_entries
+        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} depth layer(s), {} list entries/frame, PSF texture {:.1} MiB",
+        r.focus_d,
+        r.pupil_mm,
+        r.max_radius_px,
+        r.layers,
+        r.list_entries,
+        r.psf_texture_bytes as f64 / f64::from(1u32 << 20)
     );
     if let Some(f) = &r.field {
         println!(

@@ -381,14 +381,15 @@ mod tests {
                 (8, StorageBuffer, Read),
                 (9, StorageBuffer, Read),
                 (10, StorageBuffer, Read),
-                (11, UniformBuffer, Read),
+                (11, StorageBuffer, Read),
+                (12, UniformBuffer, Read),
             ]
         );
         // the frame block: 20 four-byte scalars, std140-packed like repr(C)
-        let frame = r.bindings[11].block.as_ref().unwrap();
+        let frame = r.bindings[12].block.as_ref().unwrap();
         assert_eq!(frame.bytes, 80);
         assert_eq!(frame.members[13], ("focal_px".to_string(), 52));
-        assert!(r.bindings[10].block.is_none());
+        assert!(r.bindings[11].block.is_none());
         // Merge reads and writes its fragments; tile count reads them and updates counts.
         let merge = reflect(crate::shaders::RENDER_SPLAT_MERGE_COMP).unwrap();
         assert_eq!(merge.bindings[0].access, Read);

@@ -16,15 +16,16 @@
 // loops of one invocation together at 65535 and silently stops the rest, leaving pixels
 // unwritten on long tile lists (off axis the four-node and per-pixel loops ran per fragment).
 #extension GL_EXT_control_flow_attributes : require
-#define FRAME_BINDING 11
+#define FRAME_BINDING 12
 #define BANDS_BINDING 7
+#define ATLAS_BINDING 8
 #include "splat.glsl"
 #include "band.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
-FRAGMENT_BUFFERS(1, 8, 9, 10, readonly)
+FRAGMENT_BUFFERS(1, 9, 10, 11, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 3) readonly buffer Offsets { uint offsets[]; };
@@ -32,6 +33,7 @@ layout(std430, binding = 4) readonly buffer Entries { uvec2 entries[]; };
 layout(binding = 5, rgba32f) writeonly uniform image2D color_out;
 layout(std430, binding = 6) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
 #include "field.glsl"
+#include "atlas.glsl"
 
 // The tile side is fixed per pipeline, so the per-thread pixel arrays have a compile-time
 // size and live in registers (dynamic sizes cost CPU implementations such as lavapipe dearly).
@@ -50,21 +52,27 @@ shared uvec4 batch_nodes[64];  // off axis: the four field nodes around the frag
 shared vec4 batch_node_weights[64];
 shared uint unsaturated;       // threads with a pixel whose closed groups cover < 1 − ε
 
-// RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block), from
-// the tile at texel `origin` (one per field node).
-vec3 kernel_rgb(vec2 d, float l, float index, vec2 origin) {
-    vec2 extent = field_header[0].xy * field_header[0].z;
-    float layers = float(frame.object_count * level_count());
-    vec3 uvw = vec3((origin + float(frame.max_radius) + 0.5 + d) / extent,
-                    (l * float(frame.object_count) + index + 0.5) / layers);
-    float k = float(2u * level_block_radius(uint(l)) + 1u);
+// RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block) of
+// field node `node`, at offset d from the kernel's centre. Past the block's zero ring, and
+// past the largest level, the kernel is zero and the atlas holds other blocks or nothing:
+// nothing is read there.
+vec3 kernel_rgb(vec2 d, float l, float index, uint node) {
+    uint level = uint(l);
+    uint r = level_block_radius(level);
+    if (level >= level_count() || any(greaterThanEqual(abs(d), vec2(float(r + 1u))))) {
+        return vec3(0.0);
+    }
+    vec3 extent = vec3(textureSize(psf_texture, 0));
+    vec3 uvw = vec3((vec2(kernel_centre(node, level)) + 0.5 + d) / extent.xy,
+                    (index + 0.5) / extent.z);
+    float k = float(2u * r + 1u);
     return textureLod(psf_texture, uvw, 0.0).rgb / (k * k);
 }
 
-// Per-channel kernel of fragment f at offset d in the tile at `origin`: each channel's radius
+// Per-channel kernel of fragment f at offset d at field node `node`: each channel's radius
 // lies between two radius levels; when all channels' levels fall within three consecutive ones
 // (the usual case), the three lookups serve every channel, else each channel takes its own two.
-vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
+vec3 kernel_at(Fragment f, vec2 d, uint node) {
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
     vec3 t = level - lo;
@@ -72,9 +80,9 @@ vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
     float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
     vec3 w;
     if (top - base <= 2.0) {
-        vec3 s0 = kernel_rgb(d, base, f.index, origin);
-        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index, origin) : s0;
-        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index, origin) : s1;
+        vec3 s0 = kernel_rgb(d, base, f.index, node);
+        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index, node) : s0;
+        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index, node) : s1;
         // Component-wise selection (no dynamic indexing): channel c reads s[i0] and s[i0 + 1].
         vec3 i0 = lo - base;
         vec3 a = mix(mix(s0, s1, step(0.5, i0)), s2, step(1.5, i0));
@@ -82,8 +90,8 @@ vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
         w = mix(a, b, t);
     } else {
         [[unroll]] for (int c = 0; c < 3; c++) {
-            float a = kernel_rgb(d, lo[c], f.index, origin)[c];
-            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, origin)[c], t[c]) : a;
+            float a = kernel_rgb(d, lo[c], f.index, node)[c];
+            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, node)[c], t[c]) : a;
         }
     }
     return w;
@@ -94,14 +102,14 @@ vec3 kernel_at(Fragment f, vec2 d, vec2 origin) {
 vec3 fragment_weight(uint j, Fragment f, vec2 d) {
     vec3 w;
     if (OFF_AXIS == 0u) {
-        w = kernel_at(f, d, vec2(0.0));
+        w = kernel_at(f, d, 0u);
     } else {
         w = vec3(0.0);
         uvec4 nodes = batch_nodes[j];
         vec4 weights = batch_node_weights[j];
         [[unroll]] for (uint k = 0u; k < 4u; k++) {
             if (weights[k] > 0.0) {
-                w += weights[k] * kernel_at(f, d, node_origin(nodes[k]));
+                w += weights[k] * kernel_at(f, d, nodes[k]);
             }
         }
     }

@@ -1,12 +1,15 @@
 #version 460
 // Builds the per-frame PSF texture: kernels of up to four (pupil, focus) grid states blended
-// with bilinear weights, laid out as layer = level·No + o, each level's (2r+1)² block (r its
-// block radius) centred at texel Rmax, every other texel zero. Values are scaled by (2r+1)² so
-// that half floats keep their precision (a kernel's mean texel becomes ~1); the convolution
-// pass divides it back out.
+// with bilinear weights, written into the atlas (glsl/common/atlas.glsl): each radius level's
+// (2r+1)² block, r its block radius, around its centre in the node's region, inside a ring of
+// zeros, at the layer of its object distance. Values are scaled by (2r+1)² so that half floats
+// keep their precision (a kernel's mean texel becomes ~1); the convolution pass divides it
+// back out.
 #extension GL_GOOGLE_include_directive : require
-#define FRAME_BINDING 5
+#define FRAME_BINDING 6
+#define ATLAS_BINDING 5
 #include "splat.glsl"
+#include "atlas.glsl"
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
@@ -18,22 +21,19 @@ layout(std430, binding = 3) readonly buffer Set3 { float set3[]; };
 layout(binding = 4) writeonly uniform image3D psf_texture;
 
 // One dispatch per chunk of radius levels and field node (`PsfTexturePush` in
-// src/render/splat/psf_texture.rs). The tile code is column | row << 10 | data offset << 20
-// (src/render/splat/field.rs). A tile is pitch = side + 2·offset texels square, its kernels
-// start `offset` texels in: off axis a zero margin keeps bilinear reads at a kernel's edge out
-// of the neighbouring tile.
+// src/render/splat/psf_texture.rs): invocation (x, y) of layer z writes texel (x, y) of the
+// square of level first_level + z / No, object z % No, that holds the block and its ring.
 layout(push_constant) uniform PsfTexturePush {
     uint first_level;    // the chunk's radius levels [first_level, end_level)
     uint end_level;
     uint first_texel;    // index of the chunk's first texel in a whole kernel set
-    uint tile_code;
+    uint node;           // the field node (h-major; on axis 0)
     vec4 corner_weights; // bilinear weights of the four grid states (unused ones zero)
 } push;
 #define WEIGHTS push.corner_weights
 #define FIRST_LEVEL push.first_level
 #define END_LEVEL push.end_level
 #define FIRST_TEXEL push.first_texel
-#define TILE_CODE push.tile_code
 
 uint texels_below(uint r) {
     return r * (4u * r * r - 1u) / 3u;
@@ -58,20 +58,19 @@ uint texels_below_level(uint level) {
 }
 
 void main() {
-    uint side = 2u * frame.max_radius + 1u;
-    uint offset = TILE_CODE >> 20u;
-    uint pitch = side + 2u * offset;
-    uvec2 tile = uvec2(TILE_CODE & 1023u, (TILE_CODE >> 10u) & 1023u);
     uvec3 id = gl_GlobalInvocationID;
-    uint layer = FIRST_LEVEL * frame.object_count + id.z;
-    if (id.x >= pitch || id.y >= pitch || layer >= END_LEVEL * frame.object_count) {
+    uint level = FIRST_LEVEL + id.z / frame.object_count;
+    if (level >= END_LEVEL) {
         return;
     }
-    uint level = layer / frame.object_count;
+    uint o = id.z % frame.object_count;
     uint r = level_block_radius(level);
-    uint o = layer % frame.object_count;
-    int dx = int(id.x) - int(offset + frame.max_radius);
-    int dy = int(id.y) - int(offset + frame.max_radius);
+    // the block and its one-texel ring of zeros
+    if (id.x > 2u * r + 2u || id.y > 2u * r + 2u) {
+        return;
+    }
+    int dx = int(id.x) - int(r + 1u);
+    int dy = int(id.y) - int(r + 1u);
     vec3 value = vec3(0.0);
     if (abs(dx) <= int(r) && abs(dy) <= int(r)) {
         uint kside = 2u * r + 1u;
@@ -84,5 +83,6 @@ void main() {
         if (WEIGHTS.w > 0.0) value += WEIGHTS.w * vec3(set3[i], set3[i + 1u], set3[i + 2u]);
         value *= float(kside * kside);
     }
-    imageStore(psf_texture, ivec3(tile * pitch + id.xy, layer), vec4(value, 0.0));
+    ivec2 at = ivec2(kernel_centre(push.node, level)) + ivec2(dx, dy);
+    imageStore(psf_texture, ivec3(at, int(o)), vec4(value, 0.0));
 }

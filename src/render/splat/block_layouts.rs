@@ -105,12 +105,12 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "psf texture",
             RENDER_SPLAT_PSF_TEXTURE_COMP,
-            Some(5),
+            Some(6),
             Some(layout_of!(PsfTexturePush {
                 first_level,
                 end_level,
                 first_texel,
-                tile_code,
+                node,
                 corner_weights
             })),
         ),
@@ -129,7 +129,7 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "convolve",
             RENDER_SPLAT_CONVOLVE_COMP,
-            Some(11),
+            Some(12),
             Some(band_push()),
         ),
         (

@@ -4,8 +4,8 @@
 use super::bands::{band_table_bytes, BAND_TABLE_HEADER_BYTES};
 use super::{
     band_header_at, band_plan, binding_limit, convolve, field, fragments, input, merge, prefix_sum,
-    psf_texture, tile_count, tile_fill, tile_sort, FrameResources, PsfTextureFormat, SplatSettings,
-    Splatter, FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
+    psf_texture, tile_count, tile_fill, tile_sort, FrameResources, SplatSettings, Splatter,
+    FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
 };
 use crate::gpu::{
     Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat,
@@ -63,11 +63,7 @@ impl Splatter {
             )));
         }
         let layout = field::TextureLayout::new(&grid, field_axes.as_ref());
-        let texel_bytes = match settings.texture_format {
-            PsfTextureFormat::Rgba16Float => 8,
-            PsfTextureFormat::Rgba32Float => 16,
-        };
-        layout.check(ctx, texel_bytes)?;
+        layout.check(ctx, settings.texture_format.texel_bytes())?;
         let nodes: &[KernelGrid] = if node_grids.is_empty() {
             std::slice::from_ref(&grid)
         } else {
@@ -91,8 +87,8 @@ impl Splatter {
             }
         }
         let texture = psf_texture::create_texture(ctx, layout.extent(), settings.texture_format)?;
-        let field_table =
-            field::FieldTable::new(ctx, &layout, field_axes.as_ref(), grid.objects.count)?;
+        let field_table = field::FieldTable::new(ctx, field_axes.as_ref(), grid.objects.count)?;
+        let atlas = Buffer::from_slice(ctx, "PSF texture atlas", &layout.atlas_words())?;
         let radii = Buffer::new(
             ctx,
             "object radii",
@@ -104,6 +100,7 @@ impl Splatter {
             settings,
             resident,
             layout,
+            atlas,
             field_table,
             node_grids,
             field_axes,

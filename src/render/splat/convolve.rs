@@ -27,6 +27,7 @@ impl ConvolvePass {
                         BindingKind::StorageImage,
                         BindingKind::StorageBuffer,
                         BindingKind::StorageBuffer,
+                        BindingKind::StorageBuffer,
                     ],
                 ))
                 .uniform::<FrameUniform>()
@@ -44,7 +45,8 @@ impl ConvolvePass {
         frame: FrameBlock<'_>,
         band: &BandPush,
         bands: &Buffer,
-        psf: (&Image, &Sampler),
+        // the PSF texture, its sampler and its layout (glsl/common/atlas.glsl)
+        psf: (&Image, &Sampler, &Buffer),
         field_table: &Buffer,
         fragments: &FragmentStore,
         counts: &Buffer,
@@ -61,6 +63,7 @@ impl ConvolvePass {
                 Binding::Storage(output),
                 Binding::Buffer(field_table),
                 Binding::Buffer(bands),
+                Binding::Buffer(psf.2),
             ],
         );
         bindings.push(frame.binding());

@@ -118,6 +118,8 @@ pub struct SplatStats {
     pub barriers: u32,
     pub upload_bytes: u64,
     pub readback_bytes: u64,
+    /// Device memory of the PSF texture.
+    pub psf_texture_bytes: u64,
 }
 
 /// Intermediate buffers of a single-band frame, read back for tests.
@@ -175,6 +177,8 @@ pub struct Splatter {
     /// Per node (on axis one), every kernel set resident on the GPU.
     resident: Vec<psf_texture::ResidentGrid>,
     layout: field::TextureLayout,
+    /// The texture's layout for the shaders (glsl/common/atlas.glsl), written once.
+    atlas: Buffer,
     field_table: field::FieldTable,
     texture: Image,
     sampler: Sampler,
@@ -240,6 +244,18 @@ impl Splatter {
     /// The PSF texture as the convolution pass samples it (for inspection and tests).
     pub fn psf_texture(&self) -> (&Image, &Sampler) {
         (&self.texture, &self.sampler)
+    }
+
+    /// Device memory of the PSF texture (bytes).
+    pub fn psf_texture_bytes(&self) -> u64 {
+        self.layout
+            .bytes(self.settings.texture_format.texel_bytes())
+    }
+
+    /// The texel at the centre of radius level `level`'s kernel of field node `node` (on axis
+    /// 0) in the PSF texture; its layer is the object distance's index.
+    pub fn psf_texture_centre(&self, node: u32, level: u32) -> [u32; 2] {
+        self.layout.centre(node, level)
     }
 
     /// Renders one frame through the eye's kernels for `view`.
@@ -363,6 +379,7 @@ impl Splatter {
                     commands: sync.1,
                     upload_bytes,
                     readback_bytes: output_bytes + bands::BAND_TABLE_HEADER_BYTES,
+                    psf_texture_bytes: self.psf_texture_bytes(),
                 };
                 let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
                 check_every_pixel_written(&color, w as usize)?;
@@ -466,6 +483,7 @@ impl Splatter {
             commands: sync.1,
             upload_bytes,
             readback_bytes: output_bytes + header_at + bands::BAND_TABLE_HEADER_BYTES,
+            psf_texture_bytes: self.psf_texture_bytes(),
         };
         let intermediates = if keep_intermediates {
             let mut all_entries: Vec<[u32; 2]> = entries.read(&ctx)?;
@@ -528,10 +546,23 @@ impl Splatter {
         );
         if let Some(blend) = rebuild_texture {
             rec.begin_pass("psf texture");
+            if self.texture_blend.is_none() {
+                // A read near a ring's outer edge may touch the next texel with weight zero (the
+                // filter's subtexel rounding), and unwritten memory may hold NaN, which a zero
+                // weight keeps: the atlas's gaps are zeroed once, before its first blocks.
+                // (Measured: without it, two splat tests read NaN on lavapipe.)
+                rec.clear_image(&self.texture, [0.0; 4]);
+            }
             for (node, resident) in self.resident.iter().enumerate() {
-                let tile = self.layout.tile_code(node);
-                self.psf_texture
-                    .record(rec, block, resident, blend, tile, &self.texture)?;
+                self.psf_texture.record(
+                    rec,
+                    block,
+                    resident,
+                    blend,
+                    node as u32,
+                    &self.texture,
+                    &self.atlas,
+                )?;
             }
         }
         rec.begin_pass("fragments");
@@ -629,7 +660,7 @@ impl Splatter {
                 block,
                 &band,
                 &frame.band_table,
-                (&self.texture, &self.sampler),
+                (&self.texture, &self.sampler, &self.atlas),
                 &self.field_table.buffer,
                 &frame.fragments,
                 &frame.counts,

@@ -5,7 +5,9 @@ use crate::gpu::{
     Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage, Recorder,
     TexelFormat,
 };
-use crate::psf::kernels::{level_count, texels_below_level, GridBlend, KernelGrid, KernelSet};
+use crate::psf::kernels::{
+    level_block_radius, level_count, texels_below_level, GridBlend, KernelGrid, KernelSet,
+};
 
 use super::{FrameBlock, FrameUniform};
 
@@ -20,8 +22,9 @@ pub(super) struct PsfTexturePush {
     pub end_level: u32,
     /// Index of the chunk's first texel in a whole kernel set.
     pub first_texel: u32,
-    /// The field node's tile: column | row << 10 | data offset << 20 (`field::TextureLayout`).
-    pub tile_code: u32,
+    /// The field node (h-major; on axis 0) whose region of the atlas is written
+    /// (`field::TextureLayout`).
+    pub node: u32,
     /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
     pub corner_weights: [f32; 4],
 }
@@ -42,6 +45,14 @@ pub enum PsfTextureFormat {
 }
 
 impl PsfTextureFormat {
+    /// Bytes of one texel.
+    pub fn texel_bytes(self) -> u64 {
+        match self {
+            PsfTextureFormat::Rgba16Float => 8,
+            PsfTextureFormat::Rgba32Float => 16,
+        }
+    }
+
     pub fn texel_format(self) -> TexelFormat {
         match self {
             PsfTextureFormat::Rgba16Float => TexelFormat::Rgba16Float,
@@ -151,6 +162,7 @@ impl PsfTexturePass {
                     BindingKind::StorageBuffer,
                     BindingKind::StorageBuffer,
                     BindingKind::StorageImage,
+                    BindingKind::StorageBuffer,
                 ])
                 .uniform::<FrameUniform>()
                 .push_constants::<PsfTexturePush>()
@@ -158,17 +170,19 @@ impl PsfTexturePass {
         Ok(PsfTexturePass { pipeline })
     }
 
+    /// Writes field node `node`'s kernels for `blend` into its region of `texture`, whose
+    /// layout `atlas` holds (glsl/common/atlas.glsl).
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
         frame: FrameBlock<'_>,
         grid: &ResidentGrid,
         blend: &GridBlend,
-        tile_code: u32,
+        node: u32,
         texture: &Image,
+        atlas: &Buffer,
     ) -> GpuResult<()> {
-        // the tile's pitch: side + 2·margin (see glsl/render/splat/psf_texture.comp)
-        let side = 2 * frame.values.max_radius + 1 + 2 * (tile_code >> 20);
         let chunks = grid.sets[blend.corners[0].0].len();
         for chunk in 0..chunks {
             // Unused corners repeat the first one with weight zero (never read).
@@ -180,10 +194,12 @@ impl PsfTexturePass {
                 first_level: first.first_level,
                 end_level: first.end_level,
                 first_texel: first.first_texel,
-                tile_code,
+                node,
                 corner_weights: [weight(0), weight(1), weight(2), weight(3)],
             };
             let layers = (first.end_level - first.first_level) * frame.values.object_count;
+            // the chunk's largest block with its ring of zeros
+            let side = 2 * level_block_radius(first.end_level - 1) + 3;
             rec.dispatch(
                 &self.pipeline,
                 &[
@@ -192,6 +208,7 @@ impl PsfTexturePass {
                     Binding::Buffer(&corner(2).buffer),
                     Binding::Buffer(&corner(3).buffer),
                     Binding::Storage(texture),
+                    Binding::Buffer(atlas),
                     frame.binding(),
                 ],
                 &push,
