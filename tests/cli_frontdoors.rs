@@ -467,17 +467,23 @@ fn compare_reports_quality_and_writes_maps() {
 
 /// `--judge` measures a saved image exactly as the methods are measured, and `--truth-bin-d`
 /// changes the reference: the default truth saved and judged again is identical to the bit,
-/// a truth rounded to 0.1 D bins is not.
+/// a truth rounded to 0.1 D bins is not. `--no-warmup` times splat's first frame, which is
+/// the same image as the second.
 #[test]
 fn compare_judges_saved_images_and_coarse_truths() {
     let dir = temp_dir("judge");
     let (fine, coarse) = (dir.join("fine.exr"), dir.join("coarse.exr"));
-    let json = dir.join("judge.json");
+    let (json, warm_json) = (dir.join("judge.json"), dir.join("warm.json"));
     let common = ["compare", "--size", "96x54", "--no-slices", "--cache"];
     let run = |extra: &[&std::ffi::OsStr]| {
         run_ok(ocular().args(common).arg(cache()).args(extra));
     };
-    run(&["--truth-out".as_ref(), fine.as_os_str()]);
+    run(&[
+        "--truth-out".as_ref(),
+        fine.as_os_str(),
+        "--json".as_ref(),
+        warm_json.as_os_str(),
+    ]);
     run(&[
         "--truth-bin-d".as_ref(),
         "0.1".as_ref(),
@@ -491,9 +497,22 @@ fn compare_judges_saved_images_and_coarse_truths() {
         coarse.as_os_str(),
         "--json".as_ref(),
         json.as_os_str(),
+        "--no-warmup".as_ref(),
     ]);
-    let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let read = |path: &Path| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+    };
+    let (report, warm) = (read(&json), read(&warm_json));
     assert_eq!(report["truth_bin_d"].as_f64(), Some(0.001));
+    assert_eq!(report["splat_warmed_up"], false);
+    assert_eq!(warm["splat_warmed_up"], true);
+    let splat_db = |r: &serde_json::Value| method_row(r, "splat")["psnr_db"].as_f64();
+    assert!(splat_db(&warm).is_some_and(f64::is_finite), "{warm}");
+    assert_eq!(
+        splat_db(&report),
+        splat_db(&warm),
+        "the first splat frame must be the second's image"
+    );
     let row = |name: &str| method_row(&report, name);
     assert!(row("fine")["psnr_db"].is_null(), "{}", row("fine"));
     let coarse_db = row("coarse")["psnr_db"].as_f64();

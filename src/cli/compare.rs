@@ -79,6 +79,11 @@ pub struct CompareArgs {
     /// Skip the slice method.
     #[arg(long)]
     pub no_slices: bool,
+    /// Render splat once and time that frame (shader compilation and the kernels' upload
+    /// included) instead of timing a second frame: halves splat's cost where one frame takes
+    /// minutes (off axis at 1280×720 on a CPU device).
+    #[arg(long)]
+    pub no_warmup: bool,
     /// The ground truth: `reference` (exact per-pixel PSFs, the same blend as splat) or
     /// `views` (multi-view accumulation over the pupil: geometric optics, sees hidden
     /// surfaces, shares neither kernels nor blend; the reference is then judged too).
@@ -160,6 +165,8 @@ struct Report {
     truth_bin_d: Option<f64>,
     /// The views truth's own convergence (null for the reference truth or --truth-in).
     views_convergence: Option<ViewsConvergence>,
+    /// Whether splat's `seconds` is a second frame (true) or the first (`--no-warmup`).
+    splat_warmed_up: bool,
     methods: Vec<MethodResult>,
 }
 
@@ -392,7 +399,9 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         None
     };
     // The first splat frame compiles shaders and uploads the kernels: time the second.
-    renderer.render(&input, eye_state, Method::Splat)?;
+    if !args.no_warmup {
+        renderer.render(&input, eye_state, Method::Splat)?;
+    }
     let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
     // The layered frame is peeled and splatted in one submission, its layers never on the
     // host (tests/engine.rs: the same image as the layers read back and uploaded).
@@ -648,6 +657,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             truth_bin_d: (truth_method == Method::Reference && args.truth_in.is_none())
                 .then_some(renderer.reference_dioptre_bin_d),
             views_convergence,
+            splat_warmed_up: !args.no_warmup,
             methods,
         };
         let text = serde_json::to_string_pretty(&report)
