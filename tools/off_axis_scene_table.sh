@@ -7,11 +7,13 @@
 # Usage: tools/off_axis_scene_table.sh [BINARY] [OUT_DIR] [SIZE] [PAIRS]
 #   defaults: target/release/ocular, off_axis_out, 1280x720, and PAIRS = every scene:eye of
 #   chart and colonnade × healthy, myopia, astigmatism, keratoconus. BIN_CHECK=0 skips the
-#   bin check.
+#   bin check; WARMUP=0 renders the off-axis splat frame once and times it (compare
+#   --no-warmup: the same image, minutes less per pair).
 # Chart's truth keeps the seed paper's 0.001 D bins; colonnade's rounds vergences to 0.02 D:
 # off axis every (vergence bin, direction) pair costs its own FFT PSFs, far more pairs in a
 # deep scene at 0.001 D than in a flat one. On 2 CPU cores one chart pair
-# takes about 30 minutes (reference 18 min, the off-axis splat frame 5 min, rendered twice).
+# takes about 30 minutes (reference 18 min, the off-axis splat frame 5 min, rendered twice
+# unless WARMUP=0).
 set -euo pipefail
 bin=${1:-target/release/ocular}
 out=${2:-off_axis_out}
@@ -28,7 +30,9 @@ for pair in $pairs; do
   eye=${pair##*:}
   case $scene in colonnade) truth_bin=0.02 ;; *) truth_bin=0.001 ;; esac
   stem="$out/$scene-$eye"
-  "$bin" compare --scene "$scene" --eye "$eye" --size "$size" --off-axis --no-slices \
+  warmup=()
+  if [ "${WARMUP:-1}" = 0 ]; then warmup=(--no-warmup); fi
+  "$bin" compare --scene "$scene" --eye "$eye" --size "$size" --off-axis --no-slices "${warmup[@]}" \
     --truth-bin-d "$truth_bin" --truth-out "$stem-truth.exr" --json "$stem.json" \
     --maps "$stem" > "$stem.txt"
   "$bin" compare --scene "$scene" --eye "$eye" --size "$size" --no-slices \
