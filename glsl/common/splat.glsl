@@ -94,12 +94,11 @@ vec3 local_scale(vec2 center) {
 }
 
 // Radial and tangential shrink for a kernel of radius r: (cos²θ, cos θ) from 1.5 px up,
-// none below 0.5 px (an in-focus kernel keeps its pixel), linear between; none where it
-// would move the kernel's edge by less than a quarter pixel (src/render/projection.rs).
+// none below 0.5 px (an in-focus kernel keeps its pixel), linear between; continuous in
+// field angle and radius (src/render/projection.rs).
 vec2 shrink_for_radius(float cos_theta, float r) {
     float t = clamp(r - 0.5, 0.0, 1.0);
-    vec2 c = vec2(1.0) + t * (vec2(cos_theta * cos_theta, cos_theta) - vec2(1.0));
-    return r * (1.0 / c.x - 1.0) < 0.25 ? vec2(1.0) : c;
+    return vec2(1.0) + t * (vec2(cos_theta * cos_theta, cos_theta) - vec2(1.0));
 }
 
 // Kernel offset of screen offset d; e = radial unit vector, c = (radial, tangential) shrink.
@@ -143,28 +142,41 @@ uint block_size(Fragment f) {
     return f.size & 0x7Fu;
 }
 
-// Whether a fragment's light reaches pixel offset d. A hidden-layer fragment's light through
-// the pupil point at ρ·a in direction e lands near ρ·r·e from its centre (r: its blur radius;
-// the fragments pass oriented the rays to the kernel's side) and arrives only if that ray
-// passed the nearer surfaces (glsl/render/splat/fragments.comp, pupil_visibility). Bits
-// 3·i + l: direction i·45°, ring l of three of equal pupil area. Below a pixel of blur the
-// rays land together: the light arrives if any ray passes, and the nearer groups' coverage
-// takes the blocked share.
-float pupil_share(Fragment f, vec2 d) {
+// Per channel, the share of a fragment's light at pixel offset d that reaches the pupil. A
+// hidden-layer fragment's light through the pupil point at ρ·a in direction e lands near
+// ρ·r·e from its centre (r: that channel's blur radius; the fragments pass oriented the rays
+// to the kernel's side) and arrives only if that ray passed the nearer surfaces
+// (glsl/render/splat/fragments.comp, pupil_visibility). Bits 3·i + l: direction i·45°, ring l
+// of three of equal pupil area. A channel in focus (r below half a pixel) lands all its rays on
+// its own pixel: its light arrives if any ray passes, and the nearer groups' coverage takes
+// the blocked share; the pixel under the centre (|d| < ½) takes the inner ring's mean, since
+// no direction is defined there; between ½ and 1½ px of blur the two mix, so the share is
+// continuous in the radius. (Before, one radius for all channels made an in-focus green
+// channel depend on the single ray of direction 0 when red or blue were blurred.)
+vec3 pupil_share(Fragment f, vec2 d) {
     uint rays = f.size >> 8u;
     if ((f.size & HIDDEN_FRAGMENT) == 0u || rays == ALL_RAYS) {
-        return 1.0;
+        return vec3(1.0);
     }
     if (rays == 0u) {
-        return 0.0;
+        return vec3(0.0);
     }
-    float r = max(f.radius.r, max(f.radius.g, f.radius.b));
-    if (r < 1.0) {
-        return 1.0;
+    float dd = dot(d, d);
+    float inner = 0.0;
+    for (uint i = 0u; i < 8u; i++) {
+        inner += float((rays >> (3u * i)) & 1u);
     }
-    uint ring = min(uint(3.0 * dot(d, d) / (r * r)), 2u);
+    inner *= 0.125;
     uint direction = uint(int(round(atan(d.y, d.x) * (4.0 / 3.14159265358979))) & 7);
-    return float((rays >> (3u * direction + ring)) & 1u);
+    vec3 share;
+    for (int c = 0; c < 3; c++) {
+        float r = max(f.radius[c], 1e-3);
+        uint ring = min(uint(3.0 * dd / (r * r)), 2u);
+        float ray = float((rays >> (3u * direction + ring)) & 1u);
+        float seen = dd < 0.25 ? inner : ray;
+        share[c] = mix(1.0, seen, clamp(r - 0.5, 0.0, 1.0));
+    }
+    return share;
 }
 
 // How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.

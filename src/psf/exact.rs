@@ -16,6 +16,9 @@ use std::sync::{Arc, Mutex};
 pub struct Kernel {
     pub radius: u32,
     pub values: Vec<f32>,
+    /// The blur radius (px, clamped like the runtime's) the block was drawn for: what decides
+    /// how much of the pinhole's local scale applies ([`crate::render::projection::LocalScale`]).
+    pub radius_px: f64,
 }
 
 impl Kernel {
@@ -116,7 +119,14 @@ impl ExactEye {
             .into_iter()
             .map(|v| v as f32)
             .collect();
-        Ok((natural, Kernel { radius, values }))
+        Ok((
+            natural,
+            Kernel {
+                radius,
+                values,
+                radius_px: r,
+            },
+        ))
     }
 }
 
@@ -193,6 +203,7 @@ impl ExactKernels for ExactFieldEye {
             .unwrap_or_else(|_| Kernel {
                 radius: 0,
                 values: vec![1.0],
+                radius_px: 0.0,
             })
     }
 
@@ -218,6 +229,7 @@ impl ExactKernels for ExactEye {
             .unwrap_or_else(|_| Kernel {
                 radius: 0,
                 values: vec![1.0],
+                radius_px: 0.0,
             })
     }
 }

@@ -119,4 +119,88 @@ impl PixelBlend {
             0.0
         }
     }
+
+    /// C + (1 − A)·behind where something is known to lie behind the pixel
+    /// ([`background_behind`]), else C / A.
+    pub fn resolve_over(mut self, behind: Option<f32>) -> f32 {
+        match behind {
+            Some(b) => {
+                self.close_group();
+                self.color + (1.0 - self.alpha).max(0.0) * b
+            }
+            None => self.resolve(),
+        }
+    }
+}
+
+/// What lies behind pixel `(x, y)` of a one-layer frame, for the coverage its groups leave.
+///
+/// A single colour + depth layer does not say what a near fragment hides; dividing by the
+/// coverage would fill that hole with the fragment's own light (a point light before a distant
+/// background would gain up to a fifth of its energy). Behind a near surface lies the surface
+/// that surrounds it from behind: along eight directions, past the first step to a farther
+/// vergence (by more than `tolerance_d`) within the pixel's own blur reach
+/// (`ceil(radius_px) + 1` steps: the hole is as wide as its kernel), as many pixels of that
+/// surface as the reach (while its vergence runs on within the tolerance). Their mean colour
+/// is the best guess of a texture whose continuation is hidden; `None` where there is no such
+/// neighbour (a surface at the back; the frame's border keeps the division). The GPU's copy is
+/// `background_behind` in glsl/render/splat/convolve.comp.
+pub fn background_behind(
+    (width, height): (usize, usize),
+    (x, y): (usize, usize),
+    dioptre: &dyn Fn(usize) -> f32,
+    color: &dyn Fn(usize) -> [f32; 3],
+    radius_px: f32,
+    tolerance_d: f32,
+) -> Option<[f32; 3]> {
+    const STEPS: [(i64, i64); 8] = [
+        (1, 0),
+        (1, 1),
+        (0, 1),
+        (-1, 1),
+        (-1, 0),
+        (-1, -1),
+        (0, -1),
+        (1, -1),
+    ];
+    let reach = radius_px.ceil() as i64 + 1;
+    let own = dioptre(y * width + x);
+    let (mut sum, mut found) = ([0.0f32; 3], 0i64);
+    for (sx, sy) in STEPS {
+        let mut previous = own;
+        let mut surface: Option<f32> = None;
+        let mut taken = 0i64;
+        for s in 1..=2 * reach {
+            let (qx, qy) = (x as i64 + s * sx, y as i64 + s * sy);
+            if qx < 0 || qy < 0 || qx >= width as i64 || qy >= height as i64 {
+                break;
+            }
+            let q = qy as usize * width + qx as usize;
+            let v = dioptre(q);
+            match surface {
+                None => {
+                    if s > reach {
+                        break;
+                    }
+                    if previous - v <= tolerance_d {
+                        previous = v;
+                        continue;
+                    }
+                }
+                Some(last) => {
+                    if taken >= reach || (v - last).abs() > tolerance_d {
+                        break;
+                    }
+                }
+            }
+            let c = color(q);
+            for k in 0..3 {
+                sum[k] += c[k];
+            }
+            taken += 1;
+            surface = Some(v);
+        }
+        found += taken;
+    }
+    (found > 0).then(|| sum.map(|v| v / found as f32))
 }

@@ -16,7 +16,9 @@
 //! smear an in-focus one (a single texel) over its neighbours, while the true screen kernel
 //! of a PSF far smaller than a pixel is that one pixel at any scale. So the map is applied in
 //! full to kernels of radius >= 1.5 px and not at all below 0.5 px, linearly between
-//! ([`LocalScale::for_radius`]).
+//! ([`LocalScale::for_radius`]). The map is a continuous function of the field angle and the
+//! radius: there is no threshold under which it is skipped, since a kernel that switches
+//! between exact texel reads and bilinear ones draws a visible circle around the centre.
 
 /// A frame's projection: its size in pixels and vertical field of view.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,17 +44,10 @@ impl LocalScale {
 
     /// Radial and tangential shrink (kernel pixels per screen pixel) for a kernel of
     /// `radius_px`: (cos²θ, cos θ) from 1.5 px up, (1, 1) below 0.5 px, linear between.
-    /// Where the map would move the kernel's edge by less than a quarter pixel it is not
-    /// applied at all: the frame's centre then costs what a narrow frame does.
     pub fn for_radius(&self, radius_px: f64) -> [f64; 2] {
         let t = (radius_px - 0.5).clamp(0.0, 1.0);
         let c = self.cos_theta;
-        let shrink = [1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0)];
-        if radius_px * (1.0 / shrink[0] - 1.0) < 0.25 {
-            [1.0, 1.0]
-        } else {
-            shrink
-        }
+        [1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0)]
     }
 
     /// How far (whole pixels, per screen axis) a kernel of block radius `r` read at the

@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use rayon::prelude::*;
 
-use super::blend::{BlendSettings, PixelBlend};
+use super::blend::{background_behind, BlendSettings, PixelBlend};
 use super::projection::LocalScale;
 use super::splat::FrameInput;
 
@@ -114,12 +114,21 @@ pub fn render_binned(
     let natural: Vec<u32> = (0..w * h)
         .map(|i| kernel_of(i).iter().map(|k| k.radius).max().unwrap_or(0))
         .collect();
+    // The continuous radius, as the runtime's fragments carry it: the block radius is its
+    // ceiling, and would switch the local scale on in steps.
+    let radius_px: Vec<f64> = (0..w * h)
+        .map(|i| kernel_of(i).iter().map(|k| k.radius_px).fold(0.0, f64::max))
+        .collect();
     let reach: Vec<i64> = natural
         .iter()
+        .zip(&radius_px)
         .zip(&scales)
-        .map(|(&r, s)| i64::from(s.reach_px(r, f64::from(r))))
+        .map(|((&r, &rp), s)| i64::from(s.reach_px(r, rp)))
         .collect();
     let max_reach = reach.iter().copied().max().unwrap_or(0);
+    // One layer: the coverage a near fragment's groups leave is filled with what surrounds it
+    // from behind (the grouped blend only; the paper's blend divides by the coverage).
+    let fill = input.hidden_layers.is_empty() && blend.mode == super::blend::BlendMode::Grouped;
     const TILE: usize = 16;
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
@@ -168,7 +177,7 @@ pub fn render_binned(
                         }
                         let s = &scales[i];
                         let d = [(px - fx) as f64, (py - fy) as f64];
-                        let r = f64::from(natural[i]);
+                        let r = radius_px[i];
                         let scaled = s.for_radius(r)[0] < 1.0;
                         for ((p, k), &c) in pixel.iter_mut().zip(kernel_of(i)).zip(&input.color[i])
                         {
@@ -181,7 +190,21 @@ pub fn render_binned(
                             p.add(blend, dioptres[i] as f32, weight, c);
                         }
                     }
-                    let value = pixel.map(PixelBlend::resolve);
+                    let behind = fill.then(|| {
+                        background_behind(
+                            (w, h),
+                            (px as usize, py as usize),
+                            &|i| dioptres[i] as f32,
+                            &|i| {
+                                let c = input.color[i];
+                                [c[0], c[1], c[2]]
+                            },
+                            radius_px[py as usize * w + px as usize] as f32,
+                            blend.group_tolerance_d,
+                        )
+                    });
+                    let value =
+                        [0, 1, 2].map(|c| pixel[c].resolve_over(behind.flatten().map(|b| b[c])));
                     out.push((
                         py as usize * w + px as usize,
                         [value[0], value[1], value[2], 1.0],

@@ -168,9 +168,8 @@ pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
     let c = frame.cos_theta(f.center[0], f.center[1]);
     let t = (radius - 0.5).clamp(0.0, 1.0);
     let (cr, ct) = (1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0));
-    // No map where it would move the kernel's edge by less than a quarter pixel; else the
-    // extent of the square |k| < r + 1 under the inverse map along the screen axes.
-    if radius * (1.0 / cr - 1.0) >= 0.25 {
+    // The extent of the square |k| < r + 1 under the inverse map along the screen axes.
+    if cr < 1.0 {
         let u = f.center[0] - 0.5 * frame.width as f32;
         let v = f.center[1] - 0.5 * frame.height as f32;
         let rho = (u * u + v * v).sqrt();

@@ -147,6 +147,7 @@ impl ExactKernels for ExactSynthetic {
         Kernel {
             radius,
             values: self.eye.kernel_values(channel, dioptre, r + 0.5, radius),
+            radius_px: r,
         }
     }
 }

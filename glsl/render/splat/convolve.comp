@@ -139,6 +139,59 @@ void close_group(inout vec3 C, inout vec3 A, inout vec3 Cg, inout vec3 Ag, inout
     Gg = vec3(0.0);
 }
 
+// One layer (no hidden surfaces in the input): what a near fragment hides is unknown, and
+// dividing by the coverage would fill the hole behind it with its own light (a point light
+// before a distant background gains up to a fifth of its energy). What lies behind is the
+// surface that surrounds the near one from behind: along eight directions from the pixel, past
+// the first step to a farther vergence (more than the group tolerance) within the pixel's own
+// blur reach (the hole is as wide as its kernel), as many pixels of that surface as the reach.
+// Their mean colour (the best guess of a texture whose continuation is hidden) fills the
+// coverage the pixel's groups leave; a pixel with no such neighbour (a surface at the back, or
+// the frame's border) keeps the division. src/render/blend.rs::background_behind is the CPU's.
+bool background_behind(uvec2 pixel, out vec3 colour) {
+    colour = vec3(0.0);
+    if (frame.layers != 1u || frame.blend_mode != 0u) {
+        return false;
+    }
+    Fragment own = load_fragment(pixel.y * frame.width + pixel.x);
+    int reach = int(ceil(max(own.radius.r, max(own.radius.g, own.radius.b)))) + 1;
+    float found = 0.0;
+    for (uint i = 0u; i < 8u; i++) {
+        ivec2 step_px = ivec2(round(vec2(cos(float(i) * 0.78539816), sin(float(i) * 0.78539816))));
+        float previous = own.dioptre;
+        int taken = 0;
+        float surface = 0.0;
+        for (int s = 1; s <= 2 * reach; s++) {
+            ivec2 q = ivec2(pixel) + s * step_px;
+            if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.width) || q.y >= int(frame.height)) {
+                break;
+            }
+            Fragment g = load_fragment(uint(q.y) * frame.width + uint(q.x));
+            if (taken == 0) {
+                if (s > reach) {
+                    break;
+                }
+                if (previous - g.dioptre > frame.group_tolerance_d) {
+                    surface = g.dioptre;
+                    taken = 1;
+                    colour += g.color;
+                }
+                previous = g.dioptre;
+            } else {
+                if (taken >= reach || abs(g.dioptre - surface) > frame.group_tolerance_d) {
+                    break;
+                }
+                colour += g.color;
+                taken++;
+                surface = g.dioptre;
+            }
+        }
+        found += float(taken);
+    }
+    colour /= max(found, 1.0);
+    return found > 0.0;
+}
+
 void main() {
     load_band();
     uint tile = band.first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
@@ -211,7 +264,7 @@ void main() {
                 } else {
                     w = fragment_weight(j, f, d);
                 }
-                float g = pupil_share(f, d);
+                vec3 g = pupil_share(f, d);
                 if (grouped) {
                     if (last[q] >= 0.0 && abs(f.dioptre - last[q]) > frame.group_tolerance_d) {
                         close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
@@ -248,6 +301,11 @@ void main() {
         close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
         uvec2 pixel = uvec2(centre[q]);
         if (pixel.x < frame.width && pixel.y < frame.height) {
+            vec3 behind;
+            if (any(lessThan(A[q], vec3(1.0))) && background_behind(pixel, behind)) {
+                C[q] += max(vec3(1.0) - A[q], vec3(0.0)) * behind;
+                A[q] = max(A[q], vec3(1.0));
+            }
             vec3 a = A[q];
             vec3 color = vec3(a.r > 0.0 ? C[q].r / a.r : 0.0,
                               a.g > 0.0 ? C[q].g / a.g : 0.0,
