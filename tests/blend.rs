@@ -16,6 +16,7 @@ use ocular::render::splat::{FrameInput, MergeSettings, SplatSettings, Splatter, 
 
 const NO_MERGE: MergeSettings = MergeSettings {
     levels: 0,
+    blur_per_block: 0.0,
     min_radius_px: 5.0,
     color_tolerance: 0.1,
     dioptre_tolerance: 0.01,

@@ -12,10 +12,11 @@ layout(push_constant) uniform BandPush {
     uint entry_capacity; // entries the list buffer holds: lists past it are not touched
 } band_push;
 
-// Header (band count, status, total entries, live fragments), then two uvec4 per slot:
-// (first tile, end tile, first entry, 0) and the indirect dispatch of the per-tile passes.
+// Header (band count, status, total entries, live fragments; kernel evaluations low and high
+// words, 0, 0), then two uvec4 per slot: (first tile, end tile, first entry, 0) and the
+// indirect dispatch of the per-tile passes.
 layout(std430, binding = BANDS_BINDING) readonly buffer BandTable {
-    uvec4 band_header;
+    uvec4 band_header[2];
     uvec4 band_slots[];
 };
 

@@ -201,9 +201,9 @@ float fragment_reach(Fragment f) {
     return block_size(f) > 1u ? r + 0.5 : r;
 }
 
-// Inclusive tile rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of
-// the fragment's centre on both axes. Exact for the square kernel support; empty if off screen.
-ivec4 fragment_tiles(Fragment f) {
+// Inclusive rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of the
+// fragment's centre on both axes (the convolution's reach test). Empty if off screen.
+ivec4 fragment_pixels(Fragment f) {
     float reach = fragment_reach(f);
     // Pixel px has centre px + 0.5; it is covered when |px + 0.5 - c| <= reach.
     ivec2 p0 = ivec2(ceil(f.center - 0.5 - reach));
@@ -213,8 +213,17 @@ ivec4 fragment_tiles(Fragment f) {
     if (p0.x > p1.x || p0.y > p1.y) {
         return ivec4(0, 0, -1, -1);
     }
+    return ivec4(p0, p1);
+}
+
+// Inclusive tile rectangle of `fragment_pixels`. Exact for the square kernel support.
+ivec4 fragment_tiles(Fragment f) {
+    ivec4 p = fragment_pixels(f);
+    if (p.x > p.z) {
+        return p;
+    }
     int t = int(frame.tile_size);
-    return ivec4(p0 / t, p1 / t);
+    return ivec4(p.xy / t, p.zw / t);
 }
 
 #endif

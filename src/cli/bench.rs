@@ -127,6 +127,13 @@ struct Report {
     total: Stat,
     wall_ms_per_frame: Stat,
     list_entries: u64,
+    /// Fragments left after merging (the splat's level of detail).
+    live_fragments: u64,
+    /// (pixel, fragment) pairs within reach per frame: the convolution's work, read without a
+    /// clock.
+    kernel_evaluations: u64,
+    /// Kernel evaluations per pixel (per visible pixel; hidden layers add to it).
+    evaluations_per_pixel: f64,
     max_radius_px: u32,
     /// Device memory of the PSF texture (bytes).
     psf_texture_bytes: u64,
@@ -169,6 +176,8 @@ struct TimedFrames {
     totals: Vec<f64>,
     walls: Vec<f64>,
     list_entries: u64,
+    live_fragments: u64,
+    kernel_evaluations: u64,
     psf_texture_bytes: u64,
     counters: Counters,
 }
@@ -261,6 +270,8 @@ fn time_frames(
         totals: Vec::with_capacity(args.frames),
         walls: Vec::with_capacity(args.frames),
         list_entries: 0,
+        live_fragments: 0,
+        kernel_evaluations: 0,
         psf_texture_bytes: 0,
         counters: Counters::default(),
     };
@@ -285,6 +296,8 @@ fn time_frames(
         t.walls.push(wall_ms);
         if let Some(s) = out.stats {
             t.list_entries = s.list_entries;
+            t.live_fragments = s.live_fragments;
+            t.kernel_evaluations = s.kernel_evaluations;
             t.psf_texture_bytes = s.psf_texture_bytes;
             t.counters = Counters {
                 submissions: s.submissions,
@@ -412,6 +425,8 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         totals,
         walls,
         list_entries,
+        live_fragments,
+        kernel_evaluations,
         psf_texture_bytes,
         counters,
     } = timed;
@@ -451,6 +466,9 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         total: splat_total,
         wall_ms_per_frame: stat("wall", &walls),
         list_entries,
+        live_fragments,
+        kernel_evaluations,
+        evaluations_per_pixel: kernel_evaluations as f64 / (f64::from(width) * f64::from(height)),
         max_radius_px,
         psf_texture_bytes,
         field,
@@ -493,13 +511,16 @@ fn print_table(r: &Report) {
         r.scene, r.eye, r.width, r.height, r.device, r.driver
     );
     println!(
-        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} depth layer(s), {} list entries/frame, PSF texture {:.1} MiB",
+        "focus {:.3} D, pupil {:.2} mm, Rmax {} px, {} depth layer(s), PSF texture {:.1} MiB",
         r.focus_d,
         r.pupil_mm,
         r.max_radius_px,
         r.layers,
-        r.list_entries,
         r.psf_texture_bytes as f64 / f64::from(1u32 << 20)
+    );
+    println!(
+        "per frame: {} fragments after merging, {} list entries, {} kernel evaluations ({:.1} per pixel)",
+        r.live_fragments, r.list_entries, r.kernel_evaluations, r.evaluations_per_pixel
     );
     if let Some(f) = &r.field {
         println!(

@@ -155,11 +155,21 @@ pub struct SplatArgs {
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
     /// Storage of the PSF texture the splatting samples.
-    #[arg(long, value_enum, default_value = "rgba16f")]
+    /// auto: rgba16f on a GPU, rgba32f on a CPU implementation (lavapipe), where it is faster.
+    #[arg(long, value_enum, default_value = "auto")]
     pub texture_format: crate::render::splat::PsfTextureFormat,
-    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4 blocks.
+    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4 blocks, … 5 = up to 32×32.
     #[arg(long, default_value_t = 1)]
     pub merge_levels: u32,
+    /// Level of detail by blur: merge a block of side s once every kernel in it is at least
+    /// this many times s in radius, whatever its colours (0 = the seed paper's colour rule).
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    pub merge_blur_per_block: f32,
     /// Merge a block only if its smallest blur radius is at least this (px).
     #[arg(
         long,
@@ -188,6 +198,7 @@ impl SplatArgs {
             texture_format: self.texture_format,
             merge: crate::render::splat::MergeSettings {
                 levels: self.merge_levels,
+                blur_per_block: self.merge_blur_per_block,
                 min_radius_px: self.merge_min_radius,
                 color_tolerance: self.merge_color_tolerance,
                 ..crate::render::splat::MergeSettings::default()

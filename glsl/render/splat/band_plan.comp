@@ -19,10 +19,11 @@ layout(push_constant) uniform BandPlanPush {
     uint slots;    // slots recorded in this submission
 } plan;
 
-layout(std430, binding = 0) readonly buffer Counts { uint counts[]; };   // tiles + 1: live last
+// tiles + 3: live fragments, then the frame's kernel evaluations (low and high words)
+layout(std430, binding = 0) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; }; // tiles + 1: total last
 layout(std430, binding = 2) writeonly buffer BandTable {
-    uvec4 band_header;
+    uvec4 band_header[2];
     uvec4 band_slots[];
 };
 
@@ -73,5 +74,6 @@ void main() {
     for (uint k = first_empty; k < plan.slots; k++) {
         write_slot(k, plan.tiles, plan.tiles);
     }
-    band_header = uvec4(bands, status, offsets[plan.tiles], counts[plan.tiles]);
+    band_header[0] = uvec4(bands, status, offsets[plan.tiles], counts[plan.tiles]);
+    band_header[1] = uvec4(counts[plan.tiles + 1u], counts[plan.tiles + 2u], 0u, 0u);
 }

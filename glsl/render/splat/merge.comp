@@ -1,8 +1,8 @@
 #version 460
-// Merges blocks of similar, strongly blurred fragments into one fragment, in place: the
-// merged fragment takes the block's top-left slot, the others are marked merged away (size 0).
+// Merges blocks of strongly blurred fragments into one fragment, in place: the merged
+// fragment takes the block's top-left slot, the others are marked merged away (size 0).
 // One dispatch per block size (`MergePush` in src/render/splat/merge.rs): 2 merges 2×2 single
-// pixels, 4 merges 2×2 already-merged 2×2 blocks. Thresholds scale with the block's smallest blur radius: the more
+// pixels, 4 merges 2×2 already-merged 2×2 blocks, and so on up to 32. Thresholds scale with the block's smallest blur radius: the more
 // blur, the less a small difference in colour or dioptre can show.
 #extension GL_GOOGLE_include_directive : require
 #define FRAME_BINDING 5
@@ -11,7 +11,11 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(push_constant) uniform MergePush {
-    uint block_size; // side of the blocks this dispatch makes (2 or 4)
+    uint block_size;       // side of the blocks this dispatch makes (2, 4, … 32)
+    // Level of detail by blur (> 0): a block of side s merges when every child's kernels are
+    // at least this many times s in radius, whatever its colours; 0: the seed paper's rule
+    // (colour and dioptre tolerances per pixel of blur).
+    float blur_per_block;
 } push;
 
 // Per object distance: natural radius per channel (xyz) and the smallest core radius (w).
@@ -59,18 +63,39 @@ void main() {
     if (r_min < frame.merge_min_radius) {
         return;
     }
-    float dioptre_spread = 0.0;
-    for (int a = 0; a < 4; a++) {
-        for (int b = a + 1; b < 4; b++) {
-            vec3 dc = abs(f[a].color - f[b].color);
-            if (max3(dc) >= frame.merge_color_tolerance * r_min) {
-                return;
-            }
-            dioptre_spread += abs(f[a].index - f[b].index) * frame.dioptre_step;
+    if (push.blur_per_block > 0.0) {
+        // Level of detail: under a kernel k·s wide or more, a block of s × s pixels is resolved
+        // finer than the blur can show, and its mean colour spread by the block's kernel is what
+        // the eye sees (the kernel is read at the block's centre, grown by the block's second
+        // moment below: PSF ⊛ block, light conserved). What must stay apart is depth: the
+        // children's vergences lie within the blend's group tolerance, so the merged fragment
+        // joins the same depth group and reads the same kernels.
+        if (r_min < push.blur_per_block * float(size)) {
+            return;
         }
-    }
-    if (dioptre_spread >= 6.0 * frame.merge_dioptre_tolerance * r_min) {
-        return;
+        float lo = 1e30;
+        float hi = -1e30;
+        for (int k = 0; k < 4; k++) {
+            lo = min(lo, f[k].dioptre);
+            hi = max(hi, f[k].dioptre);
+        }
+        if (hi - lo > frame.group_tolerance_d) {
+            return;
+        }
+    } else {
+        float dioptre_spread = 0.0;
+        for (int a = 0; a < 4; a++) {
+            for (int b = a + 1; b < 4; b++) {
+                vec3 dc = abs(f[a].color - f[b].color);
+                if (max3(dc) >= frame.merge_color_tolerance * r_min) {
+                    return;
+                }
+                dioptre_spread += abs(f[a].index - f[b].index) * frame.dioptre_step;
+            }
+        }
+        if (dioptre_spread >= 6.0 * frame.merge_dioptre_tolerance * r_min) {
+            return;
+        }
     }
     Fragment m;
     m.color = 0.25 * (f[0].color + f[1].color + f[2].color + f[3].color);

@@ -26,10 +26,10 @@ pub(crate) struct BandPush {
     pub entry_capacity: u32,
 }
 
-/// The band table the GPU plans (glsl/render/splat/band_plan.comp): a 16-byte header (band
-/// count, status, total entries, live fragments), then 32 bytes per slot, the band's range and
-/// the indirect dispatch of the per-tile passes.
-pub(crate) const BAND_TABLE_HEADER_BYTES: u64 = 16;
+/// The band table the GPU plans (glsl/render/splat/band_plan.comp): a 32-byte header (band
+/// count, status, total entries, live fragments, kernel evaluations as two words, two zeros),
+/// then 32 bytes per slot, the band's range and the indirect dispatch of the per-tile passes.
+pub(crate) const BAND_TABLE_HEADER_BYTES: u64 = 32;
 const BAND_SLOT_BYTES: u64 = 32;
 
 /// Bytes of a band table with `slots` slots.
@@ -52,6 +52,8 @@ pub(crate) struct PlannedBands {
     pub status: u32,
     pub total_entries: u32,
     pub live_fragments: u32,
+    /// (pixel, fragment) pairs within reach: the convolution's work.
+    pub kernel_evaluations: u64,
 }
 
 impl PlannedBands {
@@ -61,6 +63,7 @@ impl PlannedBands {
             status: header[1],
             total_entries: header[2],
             live_fragments: header[3],
+            kernel_evaluations: u64::from(header[4]) | (u64::from(header[5]) << 32),
         }
     }
 

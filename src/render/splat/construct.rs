@@ -44,9 +44,10 @@ impl Splatter {
         grid: KernelGrid,
         node_grids: Vec<KernelGrid>,
         field_axes: Option<crate::psf::field::FieldAxes>,
-        settings: SplatSettings,
+        mut settings: SplatSettings,
     ) -> crate::Result<Splatter> {
         settings.validate().map_err(crate::Error::Input)?;
+        settings.texture_format = settings.texture_format.for_device(ctx.device_info().kind);
         if !ctx.can_write_images_without_format() {
             return Err(GpuError::Unsupported(
                 "shaderStorageImageWriteWithoutFormat (needed to build the PSF texture)".into(),
@@ -206,7 +207,8 @@ impl Splatter {
                 storage,
             )?,
             fragments: fragments::FragmentStore::new(ctx, pixels, per_chunk)?,
-            counts: Buffer::new(ctx, "tile counts", (tiles + 1) * 4, Residency::Device)?,
+            // per tile, then live fragments and the kernel evaluations' two words
+            counts: Buffer::new(ctx, "tile counts", (tiles + 3) * 4, Residency::Device)?,
             cursors: Buffer::new(ctx, "tile cursors", tiles * 4, Residency::Device)?,
             offsets: Buffer::new(ctx, "tile offsets", (tiles + 1) * 4, Residency::Device)?,
             block_sums: Buffer::new(

@@ -1,5 +1,6 @@
-//! Merge pass: replaces blocks of similar, strongly blurred fragments by one fragment (2×2,
-//! then optionally 4×4). See glsl/render/splat/merge.comp.
+//! Merge pass: replaces blocks of strongly blurred fragments by one fragment (2×2, then
+//! optionally 4×4 up to 32×32): the seed paper's similar-colour rule, or level of detail by
+//! blur. See glsl/render/splat/merge.comp.
 
 use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
 
@@ -8,10 +9,13 @@ use super::{FrameBlock, FrameUniform};
 
 /// Push constants of one merge dispatch. Mirrors `MergePush` in glsl/render/splat/merge.comp.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub(super) struct MergePush {
-    /// Side of the blocks this dispatch makes: 2, then 4.
+    /// Side of the blocks this dispatch makes: 2, then 4, … 32.
     pub block_size: u32,
+    /// Level of detail by blur (see [`super::MergeSettings::blur_per_block`]); 0: the seed
+    /// paper's tolerances.
+    pub blur_per_block: f32,
 }
 
 pub(super) struct MergePass {
@@ -28,24 +32,30 @@ impl MergePass {
         Ok(MergePass { pipeline })
     }
 
-    /// `levels`: 1 merges 2×2 blocks, 2 also merges 2×2 blocks of merged blocks.
+    /// `levels`: 1 merges 2×2 blocks, 2 also merges 2×2 blocks of merged blocks, and so on.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
         frame: FrameBlock<'_>,
-        levels: u32,
+        (levels, blur_per_block): (u32, f32),
         radii: &Buffer,
         fragments: &FragmentStore,
     ) -> GpuResult<()> {
         for level in 1..=levels {
             let size = 1u32 << level;
             let blocks = [frame.values.width / size, frame.values.height / size];
+            if blocks[0] == 0 || blocks[1] == 0 {
+                break;
+            }
             let mut bindings = fragments.bind_with(&[Binding::Buffer(radii)], &[]);
             bindings.push(frame.binding());
             rec.dispatch(
                 &self.pipeline,
                 &bindings,
-                &MergePush { block_size: size },
+                &MergePush {
+                    block_size: size,
+                    blur_per_block,
+                },
                 [blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1],
             )?;
         }

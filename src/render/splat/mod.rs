@@ -103,6 +103,9 @@ pub struct SplatStats {
     pub fragments: u64,
     pub live_fragments: u64,
     pub list_entries: u64,
+    /// (pixel, fragment) pairs within reach: the convolution's work, which level of detail
+    /// keeps proportional to the pixels whatever the blur.
+    pub kernel_evaluations: u64,
     pub max_entries_per_tile: u64,
     pub bands: u32,
     /// Queue submissions, GPU allocations and host↔device bytes this frame cost (the engine's
@@ -370,6 +373,7 @@ impl Splatter {
                     fragments: pixels as u64,
                     live_fragments: u64::from(planned.live_fragments),
                     list_entries: u64::from(planned.total_entries),
+                    kernel_evaluations: planned.kernel_evaluations,
                     max_entries_per_tile: 0,
                     bands: planned.bands,
                     submissions,
@@ -474,6 +478,7 @@ impl Splatter {
             fragments: pixels as u64,
             live_fragments: live,
             list_entries: total,
+            kernel_evaluations: planned.kernel_evaluations,
             max_entries_per_tile: counts.iter().copied().max().unwrap_or(0).into(),
             bands: slots,
             submissions,
@@ -581,7 +586,10 @@ impl Splatter {
             self.merge.record(
                 rec,
                 block,
-                self.settings.merge.levels,
+                (
+                    self.settings.merge.levels,
+                    self.settings.merge.blur_per_block,
+                ),
                 &self.radii,
                 &frame.fragments,
             )?;

@@ -36,6 +36,12 @@ pub(super) struct PsfTexturePush {
 )]
 #[serde(rename_all = "lowercase")]
 pub enum PsfTextureFormat {
+    /// Half floats on a GPU (half the memory traffic of the filtered reads), single floats on
+    /// a CPU implementation such as lavapipe, whose software filter converts every half-float
+    /// texel it reads (measured there: the convolution takes about 1.7× longer with halves).
+    #[value(name = "auto")]
+    #[serde(rename = "auto")]
+    Auto,
     #[value(name = "rgba16f")]
     #[serde(rename = "rgba16f")]
     Rgba16Float,
@@ -45,18 +51,27 @@ pub enum PsfTextureFormat {
 }
 
 impl PsfTextureFormat {
-    /// Bytes of one texel.
+    /// The format `Auto` stands for on a device of this kind; others stand for themselves.
+    pub fn for_device(self, kind: crate::gpu::DeviceKind) -> PsfTextureFormat {
+        match (self, kind) {
+            (PsfTextureFormat::Auto, crate::gpu::DeviceKind::Cpu) => PsfTextureFormat::Rgba32Float,
+            (PsfTextureFormat::Auto, _) => PsfTextureFormat::Rgba16Float,
+            (f, _) => f,
+        }
+    }
+
+    /// Bytes of one texel (`Auto` counts as the larger, until resolved for a device).
     pub fn texel_bytes(self) -> u64 {
         match self {
             PsfTextureFormat::Rgba16Float => 8,
-            PsfTextureFormat::Rgba32Float => 16,
+            PsfTextureFormat::Rgba32Float | PsfTextureFormat::Auto => 16,
         }
     }
 
     pub fn texel_format(self) -> TexelFormat {
         match self {
             PsfTextureFormat::Rgba16Float => TexelFormat::Rgba16Float,
-            PsfTextureFormat::Rgba32Float => TexelFormat::Rgba32Float,
+            PsfTextureFormat::Rgba32Float | PsfTextureFormat::Auto => TexelFormat::Rgba32Float,
         }
     }
 }

@@ -7,8 +7,15 @@ use crate::render::blend::BlendSettings;
 /// When and how strongly blurred blocks are merged into one fragment.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MergeSettings {
-    /// 0 = off, 1 = 2×2 blocks, 2 = 2×2 and then 4×4 blocks.
+    /// 0 = off, 1 = 2×2 blocks, 2 = 2×2 and then 4×4 blocks, … up to [`MAX_MERGE_LEVELS`]
+    /// (32×32).
     pub levels: u32,
+    /// Level of detail by blur: a block of side s merges when the kernels of all its pixels are
+    /// at least `blur_per_block`·s in radius (and their vergences within the blend's group
+    /// tolerance), whatever its colours, so a pixel is reached by about (2·k + 1)² fragments
+    /// per surface however large the blur. 0: the seed paper's rule (`color_tolerance` and
+    /// `dioptre_tolerance`).
+    pub blur_per_block: f32,
     /// Smallest blur radius (px, over the block and the channels) for a block to merge.
     pub min_radius_px: f32,
     /// Largest colour difference between two fragments of a block, per pixel of blur radius.
@@ -22,6 +29,7 @@ impl Default for MergeSettings {
         // The seed paper's framework defaults.
         MergeSettings {
             levels: 1,
+            blur_per_block: 0.0,
             min_radius_px: 5.0,
             color_tolerance: 0.10,
             dioptre_tolerance: 0.01,
@@ -60,7 +68,7 @@ impl Default for SplatSettings {
     fn default() -> Self {
         SplatSettings {
             tile_size: 8,
-            texture_format: PsfTextureFormat::Rgba16Float,
+            texture_format: PsfTextureFormat::Auto,
             merge: MergeSettings::default(),
             max_list_bytes: 1 << 30,
             max_fragment_binding_bytes: u64::MAX,
@@ -71,6 +79,9 @@ impl Default for SplatSettings {
         }
     }
 }
+
+/// Most merge levels: blocks up to 2^5 = 32 pixels on a side.
+pub const MAX_MERGE_LEVELS: u32 = 5;
 
 /// Default early-exit threshold of the convolution.
 pub const DEFAULT_SATURATION_EPSILON: f32 = 1e-3;
@@ -83,10 +94,18 @@ impl SplatSettings {
                 self.tile_size
             ));
         }
-        if self.merge.levels > 2 {
+        if self.merge.levels > MAX_MERGE_LEVELS {
             return Err(format!(
-                "merge levels {} is not 0, 1 or 2",
+                "merge levels {} is outside 0 to {MAX_MERGE_LEVELS}",
                 self.merge.levels
+            ));
+        }
+        if !(self.merge.blur_per_block.is_finite()
+            && (0.0..=64.0).contains(&self.merge.blur_per_block))
+        {
+            return Err(format!(
+                "merge blur per block {} is outside 0 to 64",
+                self.merge.blur_per_block
             ));
         }
         if !(self.merge.min_radius_px >= 0.0
