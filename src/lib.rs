@@ -1,8 +1,8 @@
 //! ocular: renders a 3D scene as a particular human eye sees it.
 //!
-//! The map of the crate is in DESIGN.md: `optics`, `eye` and `psf` are pure numerics; `gpu` is
-//! a thin Vulkan layer that knows nothing about eyes; `render` joins them; `cli` holds one file
-//! per subcommand.
+//! The map of the crate is in docs/design.md: `optics`, `eye` and `psf` are pure numerics;
+//! `gpu` is a thin Vulkan layer that knows nothing about eyes; `render` joins them; `cli` holds
+//! one file per subcommand.
 
 pub mod aberrations;
 pub mod cli;

@@ -2,7 +2,7 @@
 //! PSF. For the four estimated eyes (the seed paper's conditions: 4 mm pupil, focus at
 //! infinity, planes at 0.5 m and 1 m), the splat runtime and the ground truth are compared with
 //! that convolution, computed here independently of their blend (it shares the exact kernel,
-//! not the method). The figures are the README's plane table:
+//! not the method). The figures are the plane table of docs/validation.md:
 //! `cargo test --release --test plane_four_eyes -- --nocapture`.
 
 mod common;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The README's off-axis figure: point lights across a 90° × 60° frame
+"""The off-axis figure of docs/off-axis.md: point lights across a 90° × 60° frame
 (tools/recipes/field_points.toml) through the wide-angle eye, rendered with the on-axis PSF
 everywhere (left) and with --off-axis (right). Each panel shows the points of the upper-right
 quadrant (h = 0, 14, 28, 42°; v = 27, 13.5, 0°), a window around each, magnified.

@@ -2,8 +2,8 @@
 # The paper's Table 3 layout on whatever GPU the machine has, without building anything there:
 # give it a release binary (cargo build --release elsewhere) and, if the machine has no Vulkan
 # loader, a folder holding libvulkan.so.1 (Debian's libvulkan1 package, unpacked). NVIDIA's
-# Vulkan driver is libGLX_nvidia.so.0, which loads only beside glvnd: on the H100 of the
-# README, libvulkan1 alone gave "Could not get 'vkCreateInstance' ... for ICD
+# Vulkan driver is libGLX_nvidia.so.0, which loads only beside glvnd: on the H100 of
+# docs/validation.md, libvulkan1 alone gave "Could not get 'vkCreateInstance' ... for ICD
 # libGLX_nvidia.so.0"; unpacking libvulkan1, libglvnd0, libglx0, libgl1, libegl1, libgles2 and
 # libopengl0 (`apt-get download`, then `dpkg -x PKG.deb /; ldconfig`) made it load.
 #

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The README's GPU tables from a folder that tools/gpu_bench.sh wrote.
+"""The GPU tables of docs/validation.md from a folder that tools/gpu_bench.sh wrote.
 
     tools/gpu_bench_table.py OUT_DIR
 
@@ -13,7 +13,7 @@ import json
 import os
 import sys
 
-PAPER_720P = "11.9–24.5"  # the seed paper's Table 3, TITAN Xp, 1280×720 (README)
+PAPER_720P = "11.9–24.5"  # the seed paper's Table 3, TITAN Xp, 1280×720 (docs/validation.md)
 SCENES = ["primitives", "colonnade"]
 EYES = ["healthy", "myopia", "astigmatism", "keratoconus"]
 

@@ -1,5 +1,5 @@
 #!/bin/bash
-# The off-axis scene table (README): `--off-axis` splat against the off-axis reference (every
+# The off-axis scene table (docs/validation.md): `--off-axis` splat against the off-axis reference (every
 # pixel's own vergence and 1° direction, no lattice), with the on-axis PSF judged against the
 # same truth as the negative control; then the truth's own dioptre bin, measured (a 0.02 D
 # truth judged against a 0.001 D one, colonnade through the myopic eye at 640×360, on axis

@@ -1,5 +1,5 @@
 #!/bin/bash
-# The off-axis table of the README: refraction and coma of an eye across the horizontal
+# The off-axis table of docs/validation.md: refraction and coma of an eye across the horizontal
 # field, one `ocular eye measure --field-deg` per row.
 #   tools/off_axis_table.sh [EYE] [PUPIL_MM] [WAVELENGTH_NM]
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/bin/bash
-# The partial-occlusion table (README): every method against the multi-view truth, whole frame
+# The partial-occlusion table (docs/validation.md): every method against the multi-view truth, whole frame
 # and occlusion-edge band, for the four eyes on primitives and colonnade.
 # Usage: tools/views_table.sh [BINARY] [OUT_DIR] [SIZE]   (defaults: target/release/ocular, views_out, 320x180)
 set -euo pipefail
@@ -29,7 +29,7 @@ for scene in ["primitives", "colonnade"]:
             cells.append(f"{m['psnr_db']:.2f} / {m['edge_band']['psnr_db']:.2f} ({m['edge_band']['mssim']:.4f})")
         print(f"| {scene} | {eye} | {r['views_convergence']['psnr_db']:.1f} | " + " | ".join(cells) + " |")
 PY
-# The README's SSIM maps (1280×720 run): one layer against two, primitives through the healthy
+# The SSIM maps of docs/validation.md (1280×720 run): one layer against two, primitives through the healthy
 # eye and colonnade through the myopic one.
 if [ "$size" = "1280x720" ]; then
   cp "$out/primitives-healthy/ssim_splat.png" tools/figures/ssim-primitives-healthy-splat.png

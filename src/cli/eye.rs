@@ -121,7 +121,7 @@ pub struct MeasureArgs {
     pub order: u32,
     /// Field direction "H,V" in degrees (object space; H towards +x, V towards +y), each
     /// within ±60° and at most 60° from the axis. Off axis the coefficients are fitted over
-    /// the elliptical pupil stretched to the unit disc (see README, "Off axis").
+    /// the elliptical pupil stretched to the unit disc (see docs/off-axis.md).
     #[arg(long, value_name = "H,V", allow_hyphen_values = true)]
     pub field_deg: Option<String>,
     /// Print the measurement as JSON.

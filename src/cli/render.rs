@@ -142,7 +142,7 @@ pub struct RenderArgs {
     /// as the views grow; compare --json reports the change when they double.
     #[arg(long, value_name = "N", value_parser = super::occlusion::parse_views)]
     pub views: Option<u32>,
-    /// Depth layers splat takes (1–8; default 1, see the README's measurements): a scene is
+    /// Depth layers splat takes (1–8; default 1, see docs/validation.md): a scene is
     /// depth-peeled to K layers, a layered EXR gives its own (at most K; default all). Hidden
     /// layers show through blurred edges; reference and slices use the visible layer only.
     #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
@@ -251,7 +251,7 @@ fn load_input(
         let fov_y_deg = args.fov_y.ok_or_else(|| {
             Error::input(
                 "--fov-y DEG is required with --color: the camera's vertical field of view in \
-                 degrees (Blender shows the horizontal one for landscape frames; see the README)",
+                 degrees (Blender shows the horizontal one for landscape frames: docs/inputs.md)",
             )
         })?;
         check_fov(fov_y_deg)?;

@@ -45,7 +45,7 @@ Split a long export across machines with --frames A..B (frames A to B−1): each
 files into the same folder, and the union is identical to one run. The folder's ocular-video.json \
 records the configuration: a run with another one is refused unless --overwrite. A frame is \
 skipped only if its bytes match the SHA-256 recorded when it was written (ocular-video.sums/). \
-See the README for Slurm, GNU parallel and Kubernetes recipes.")]
+See docs/video.md for Slurm, GNU parallel and Kubernetes recipes.")]
 pub struct VideoArgs {
     /// Built-in scene or a scene .toml file.
     #[arg(long, value_name = "NAME|FILE")]

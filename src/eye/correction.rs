@@ -11,9 +11,10 @@
 //! Conventions are clinical optometry's: sphere S and cylinder C in dioptres in
 //! minus-cylinder form (a plus-cylinder entry is transposed), axis A in degrees 1–180,
 //! counter-clockwise from the eye's +x axis, the same axis the Zernike prescription formulas
-//! of DESIGN.md §3 use. The lens has power S along its axis meridian and S + C across it.
-//! The vertex distance is from the lens to the corneal vertex; 0 is a contact lens. The
-//! lens's own chromatic aberration is left out (P/V: 0.09 D for a 5 D CR-39 lens).
+//! of docs/design.md ("Conventions and units") use. The lens has power S along its axis
+//! meridian and S + C across it. The vertex distance is from the lens to the corneal vertex;
+//! 0 is a contact lens. The lens's own chromatic aberration is left out (P/V: 0.09 D for a
+//! 5 D CR-39 lens).
 
 use super::model::{Eye, EyeError};
 use super::surface::Surface;

@@ -42,7 +42,7 @@ impl Default for BlendSettings {
     }
 }
 
-/// Default group tolerance (D); see the README's method section for the measurement.
+/// Default group tolerance (D); docs/validation.md ("The blend") has the measurements.
 pub const DEFAULT_GROUP_TOLERANCE_D: f32 = 0.05;
 
 impl BlendSettings {

@@ -24,7 +24,7 @@ use crate::{Error, Result};
 /// Samples per pixel.
 pub const MSAA_SAMPLES: u32 = 4;
 
-/// Depth layers a scene is peeled to for splat unless told otherwise (README: measured).
+/// Depth layers a scene is peeled to for splat unless told otherwise (docs/validation.md).
 pub const DEFAULT_LAYERS: u32 = 1;
 
 /// Bytes of uniforms a frame sends the device (its only host→device data once the scene is

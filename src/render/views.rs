@@ -37,7 +37,7 @@ use crate::render::Rasterizer;
 use crate::scene::FrameState;
 use crate::{Error, Result};
 
-/// Views per frame unless told otherwise (see the README for the measured convergence).
+/// Views per frame unless told otherwise (see docs/validation.md for the measured convergence).
 pub const DEFAULT_VIEWS: u32 = 256;
 /// Fewest and most views `--views` accepts.
 pub const MIN_VIEWS: u32 = 2;
