@@ -36,12 +36,17 @@ def stat(samples_ms):
     }
 
 
-def timed(frames, render):
+def timed(frames, render, renderer, overheads=None):
+    """Wall ms per frame; with `overheads`, also collects each frame's wall time beyond the
+    library's own (Renderer.last_frame["seconds"]): what the binding adds."""
     out = []
     for _ in range(frames):
         t = time.perf_counter()
         render()
-        out.append(1e3 * (time.perf_counter() - t))
+        wall = time.perf_counter() - t
+        out.append(1e3 * wall)
+        if overheads is not None:
+            overheads.append(1e3 * (wall - renderer.last_frame["seconds"]))
     return out
 
 
@@ -81,8 +86,10 @@ def main():
 
         results = {}
         for name, render in (("render", arrays), ("render_scene", scene)):
-            timed(a.warmup, render)
-            results[name] = stat(timed(a.frames, render))
+            timed(a.warmup, render, renderer)
+            overheads = []
+            results[name] = stat(timed(a.frames, render, renderer, overheads))
+            results[name]["binding_overhead_ms"] = statistics.fmean(overheads)
         assert renderer.stats["kernel_preparations"] == 1, renderer.stats
 
     bench_ms = bench["wall_ms_per_frame"]
@@ -104,7 +111,10 @@ def main():
     print(f"  ocular bench wall per frame   mean {bench_ms['mean_ms']:10.2f} ms   median {bench_ms['median_ms']:10.2f} ms")
     for name, r in results.items():
         ratio = r["mean_ms"] / bench_ms["mean_ms"]
-        print(f"  Renderer.{name:<19} mean {r['mean_ms']:10.2f} ms   median {r['median_ms']:10.2f} ms   {ratio:.3f}× bench")
+        print(
+            f"  Renderer.{name:<19} mean {r['mean_ms']:10.2f} ms   median {r['median_ms']:10.2f} ms   "
+            f"{ratio:.3f}× bench (binding adds {r['binding_overhead_ms']:.2f} ms)"
+        )
     if a.json:
         a.json.write_text(json.dumps(report, indent=2))
     worst = max(report["ratio_render"], report["ratio_render_scene"])

@@ -43,6 +43,8 @@ struct Prepared {
     /// The grid the kernels were planned on: a frame whose own plan is the same grid would
     /// get these very kernels.
     axes: crate::psf::axes::GridAxes,
+    /// Where the eye actually focuses (D): traced once per eye state.
+    focus_reached_d: f64,
     renderer: FrameRenderer,
 }
 
@@ -56,6 +58,10 @@ struct Inner {
     prepared: Option<Prepared>,
     rasterizer: Option<Rasterizer>,
     scene: Option<(String, Scene)>,
+    /// The last scene frame drawn to the host, by what drew it: a scene rendered again at the
+    /// same time, size and magnification is not drawn to the host again (splat draws it in
+    /// its own submission anyway).
+    host: Option<(HostKey, HostFrame, Vec<String>)>,
     counters: Counters,
     last: Option<FrameReport>,
 }
@@ -96,7 +102,11 @@ struct Options {
     off_axis: bool,
 }
 
+/// Scene name, time (bits), size and spectacle magnification of a host frame.
+type HostKey = (String, u64, (u32, u32), Option<[[f64; 2]; 2]>);
+
 /// A frame on the host: what the methods read, and what focus and pupil are resolved from.
+#[derive(Clone)]
 struct HostFrame {
     width: u32,
     height: u32,
@@ -312,13 +322,6 @@ impl PyRenderer {
         }
         let (pupil_mm, pupil_from) = pupil_diameter(o, frame);
         let options = self.kernel_options(o, frame.width);
-        let focus = crate::render::focus::effective_focus(
-            &eye,
-            focus_d,
-            pupil_mm,
-            &options.settings,
-            &focus_from,
-        )?;
         let state = EyeState { focus_d, pupil_mm };
         let key = Key {
             eye: eye.clone(),
@@ -344,6 +347,14 @@ impl PyRenderer {
         let mut warnings = Vec::new();
         if !reusable {
             inner.prepared = None;
+            // Fails, with the options named, where the eye cannot focus at all.
+            let focus = crate::render::focus::effective_focus(
+                &eye,
+                focus_d,
+                pupil_mm,
+                &options.settings,
+                &focus_from,
+            )?;
             let kernels = crate::render::frame::prepare_kernels(&eye, &needs, &options)?;
             warnings.extend(kernels.warnings.iter().cloned());
             let axes = kernels.plan.axes.clone();
@@ -353,6 +364,7 @@ impl PyRenderer {
             inner.prepared = Some(Prepared {
                 key,
                 axes,
+                focus_reached_d: focus.actual_d,
                 renderer,
             });
         }
@@ -362,7 +374,9 @@ impl PyRenderer {
             scene: loaded,
             ..
         } = &mut *inner;
-        let renderer = &mut prepared.as_mut().expect("prepared above").renderer;
+        let prepared = prepared.as_mut().expect("prepared above");
+        let focus_reached_d = prepared.focus_reached_d;
+        let renderer = &mut prepared.renderer;
         let rendered = match (scene, rasterizer.as_mut(), loaded.as_ref()) {
             (Some((_, time_s)), Some(raster), Some((_, scene))) if o.method == Method::Splat => {
                 let gap_d = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D;
@@ -393,7 +407,7 @@ impl PyRenderer {
         inner.last = Some(FrameReport {
             focus_d,
             focus_from,
-            focus_reached_d: focus.actual_d,
+            focus_reached_d,
             pupil_mm,
             pupil_from,
             method: o.method,
@@ -433,6 +447,15 @@ impl PyRenderer {
         let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
         if inner.scene.as_ref().is_none_or(|(n, _)| n != name) {
             inner.scene = Some((name.to_string(), Scene::load(name)?));
+            inner.host = None;
+        }
+        let scene_resolution = inner.scene.as_ref().expect("loaded above").1.resolution;
+        let size_px = size.unwrap_or((scene_resolution[0], scene_resolution[1]));
+        let host_key: HostKey = (name.to_string(), time_s.to_bits(), size_px, magnification);
+        if let Some((key, frame, warnings)) = &inner.host {
+            if *key == host_key {
+                return Ok((frame.clone(), warnings.clone()));
+            }
         }
         if inner.rasterizer.is_none() {
             inner.rasterizer = Some(Rasterizer::new(&self.ctx)?);
@@ -446,7 +469,7 @@ impl PyRenderer {
         );
         raster.set_view_magnification(magnification.unwrap_or([[1.0, 0.0], [0.0, 1.0]]));
         let state = scene.at_time(time_s);
-        let (width, height) = size.unwrap_or((scene.resolution[0], scene.resolution[1]));
+        let (width, height) = size_px;
         let drawn = raster.render(&self.ctx, &state, width, height)?;
         let mut depth_m = drawn.depth_m;
         let near = crate::render::focus::nearest_supported_m();
@@ -464,20 +487,19 @@ impl PyRenderer {
                 crate::inputs::depth::near_clamp_warning(clamped)
             ));
         }
-        Ok((
-            HostFrame {
-                width,
-                height,
-                fov_y_deg: state.camera.fov_y_deg,
-                color: drawn.color,
-                depth_m,
-                hidden: Vec::new(),
-                scene_focus_m: Some(state.focus_m),
-                scene_pupil_mm: state.pupil_mm,
-                scene_luminance_cdm2: state.luminance_cd_m2,
-            },
-            warnings,
-        ))
+        let frame = HostFrame {
+            width,
+            height,
+            fov_y_deg: state.camera.fov_y_deg,
+            color: drawn.color,
+            depth_m,
+            hidden: Vec::new(),
+            scene_focus_m: Some(state.focus_m),
+            scene_pupil_mm: state.pupil_mm,
+            scene_luminance_cdm2: state.luminance_cd_m2,
+        };
+        inner.host = Some((host_key, frame.clone(), warnings.clone()));
+        Ok((frame, warnings))
     }
 }
 
@@ -526,6 +548,7 @@ impl PyRenderer {
                 prepared: None,
                 rasterizer: None,
                 scene: None,
+                host: None,
                 counters: Counters::default(),
                 last: None,
             }),
