@@ -132,3 +132,33 @@ def test_unknown_scene_and_device(renderer):
         renderer.render_scene("no-such-scene", oc.Eye.preset("myopia"), size=(32, 18))
     with pytest.raises(ValueError, match=r"no device matches"):
         oc.Renderer(device="no-such-gpu")
+
+
+def test_other_threads_run_while_the_library_works(renderer):
+    # With the GIL held through a call, a ticking thread would stall for the call's length.
+    import threading
+    import time
+
+    ticks, stop = [], threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.002)
+
+    thread = threading.Thread(target=tick)
+    thread.start()
+    try:
+        color, depth = two_planes()
+        started = time.perf_counter()
+        renderer.render(oc.Eye.preset("keratoconus"), color, depth, fov_y_deg=FOV, focus_m=0.7,
+                        pupil_mm=6.0, method="reference")
+        oc.Eye.from_rx("-1.00 -0.50 x 90", pupil_mm=4.0)
+        finished = time.perf_counter()
+    finally:
+        stop.set()
+        thread.join()
+    inside = [t for t in ticks if started <= t <= finished]
+    gaps = np.diff([started, *inside, finished])
+    assert finished - started > 0.2
+    assert gaps.max() < 0.25 * (finished - started), (gaps.max(), finished - started)
