@@ -159,7 +159,11 @@ pub(crate) fn depth_layers(
                 report.invalid_px
             )));
         }
-        warnings.extend(report.warnings().into_iter().map(|w| format!("depth: {w}")));
+        // As for a layered EXR, the visible layer's findings are reported (a hidden layer is
+        // often one surface at one depth).
+        if k == 0 {
+            warnings.extend(report.warnings().into_iter().map(|w| format!("depth: {w}")));
+        }
         out.push(depth_m);
     }
     Ok((out, warnings))

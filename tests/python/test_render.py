@@ -162,3 +162,41 @@ def test_other_threads_run_while_the_library_works(renderer):
     gaps = np.diff([started, *inside, finished])
     assert finished - started > 0.2
     assert gaps.max() < 0.25 * (finished - started), (gaps.max(), finished - started)
+
+
+def test_a_missing_vulkan_driver_is_a_runtime_error_saying_what_to_install():
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, VK_DRIVER_FILES="/nonexistent/icd.json", OCULAR_VALIDATION="")
+    env.pop("VK_ICD_FILENAMES", None)
+    env.pop("OCULAR_DEVICE", None)
+    code = (
+        "import ocular_render as oc\n"
+        "try:\n    oc.Renderer()\n"
+        "except RuntimeError as e:\n    print('RuntimeError:', e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         check=True).stdout
+    assert out.startswith("RuntimeError: no Vulkan device found"), out
+    assert "apt-get install mesa-vulkan-drivers" in out
+
+
+def test_layered_arrays_let_hidden_surfaces_show_through_blurred_edges(renderer):
+    # Layer 0: a near plane (0.5 m) on the left, a far one (4 m) on the right; layer 1: a
+    # bright far surface behind the near plane. Focused far, the near plane's edge is blurred
+    # and only the layered frame can show what it hides there.
+    color, depth = two_planes()
+    hidden_color = np.zeros_like(color)
+    hidden_color[...] = (500.0, 500.0, 500.0)
+    hidden_depth = np.where(depth < 1.0, 4.0, np.inf).astype(np.float32)
+    colors = np.stack([color, hidden_color])
+    depths = np.stack([depth, hidden_depth])
+    eye = oc.Eye.preset("healthy")
+    args = dict(fov_y_deg=FOV, focus_m=4.0, pupil_mm=5.0)
+    one = renderer.render(eye, colors, depths, layers=1, **args)
+    assert np.array_equal(one, renderer.render(eye, color, depth, **args))
+    two = renderer.render(eye, colors, depths, layers=2, **args)
+    assert two.shape == (H, W, 3)
+    assert np.abs(two - one).max() > 1.0
