@@ -200,3 +200,23 @@ def test_layered_arrays_let_hidden_surfaces_show_through_blurred_edges(renderer)
     two = renderer.render(eye, colors, depths, layers=2, **args)
     assert two.shape == (H, W, 3)
     assert np.abs(two - one).max() > 1.0
+
+
+def test_default_focus_and_pupil_render_as_the_cli_does(tmp_path, cli, kernel_cache):
+    # No focus and no pupil: both resolve them from the frame (the depth at its centre, the
+    # Watson–Yellott pupil of its mean luminance at 30 years) and must agree to the bit.
+    color, depth = two_planes()
+    color = color * np.float32(0.05)  # a dim frame: a wide pupil
+    oc.write_exr(tmp_path / "c.exr", color)
+    oc.write_exr(tmp_path / "d.exr", depth)
+    out = tmp_path / "cli.exr"
+    subprocess.run(
+        [cli, "render", "--color", str(tmp_path / "c.exr"), "--depth", str(tmp_path / "d.exr"),
+         "--fov-y", str(FOV), "--eye", "healthy", "--cache", str(kernel_cache), "-o", str(out)],
+        check=True, capture_output=True,
+    )
+    r = oc.Renderer(cache_dir=kernel_cache)
+    ours = r.render(oc.Eye.preset("healthy"), color, depth, fov_y_deg=FOV)
+    assert r.last_frame["pupil_mm"] > 5.0
+    from_cli = oc.read_exr(out)
+    assert np.abs(ours - from_cli).max() <= 1e-6 * float(np.abs(from_cli).max())
