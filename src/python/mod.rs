@@ -12,6 +12,7 @@ use pyo3::prelude::*;
 
 mod arrays;
 mod eye;
+mod frame_options;
 mod measures;
 mod renderer;
 
