@@ -18,6 +18,7 @@ packages=(
     libvulkan1 libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
     libshaderc-dev glslang-dev spirv-tools glslc
     pkg-config binutils ca-certificates
+    python3 python3-venv python3-pip
 )
 missing=()
 for p in "${packages[@]}"; do

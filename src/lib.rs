@@ -15,6 +15,8 @@ pub mod limits;
 pub mod metrics;
 pub mod optics;
 pub mod psf;
+#[cfg(feature = "python")]
+mod python;
 pub mod render;
 pub mod scene;
 

@@ -12,7 +12,6 @@ use super::write_atomic;
 use crate::aberrations::{self, ZernikeSet};
 use crate::eye::estimate::{self, Estimate, Method, Progress, Settings};
 use crate::eye::{self, file as eye_file};
-use crate::optics::zernike::Prescription;
 use crate::{Error, Result};
 
 #[derive(Debug, Args)]
@@ -214,18 +213,13 @@ fn target(a: &EstimateArgs) -> Result<(ZernikeSet, String)> {
         let pupil = a.pupil_mm.ok_or_else(|| {
             Error::input("--rx needs --pupil-mm (the pupil the prescription's wavefront covers)")
         })?;
-        let p = Prescription::parse(rx).map_err(|e| Error::input(format!("--rx: {e}")))?;
-        let [cm, c0, cp] = p.to_zernike(pupil);
-        let mut coefficients = vec![(2, -2, cm), (2, 0, c0), (2, 2, cp)];
+        let mut set = estimate::prescription_target(rx, pupil, a.wavelength_nm.unwrap_or(555.0))
+            .map_err(|e| Error::input(format!("--rx: {e}")))?;
         for t in &a.terms {
-            coefficients.push(parse_term(t)?);
+            set.coefficients.push(parse_term(t)?);
         }
         (
-            ZernikeSet {
-                pupil_diameter_mm: pupil,
-                wavelength_nm: a.wavelength_nm.unwrap_or(555.0),
-                coefficients,
-            },
+            set,
             format!("ocular eye estimate --rx \"{rx}\" --pupil-mm {pupil}"),
         )
     } else {

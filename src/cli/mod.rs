@@ -7,7 +7,7 @@ use crate::Result;
 
 mod bench;
 mod compare;
-mod correction;
+pub(crate) mod correction;
 mod devices;
 mod edge_band;
 mod eye;
@@ -19,7 +19,7 @@ mod outputs;
 mod psf;
 mod raster;
 mod refract;
-mod render;
+pub(crate) mod render;
 mod render_output;
 mod sha256;
 mod video;
