@@ -116,7 +116,7 @@ fn steady_frames_are_one_submission_without_allocations() {
         let image_bytes = u64::from(W * H) * 16;
         assert_eq!(
             next.stats.readback_bytes,
-            image_bytes + 16,
+            image_bytes + 32,
             "image and band header"
         );
         // the pixels, the radii, the field table (its header and one node's radii) and the
@@ -209,7 +209,7 @@ fn banded_steady_frames_are_one_submission() {
         assert_eq!(next.stats.bands, first.stats.bands);
         assert_eq!(next.stats.list_entries, entries);
         let image_bytes = u64::from(W * H) * 16;
-        assert_eq!(next.stats.readback_bytes, image_bytes + 16);
+        assert_eq!(next.stats.readback_bytes, image_bytes + 32);
         assert_eq!(
             next.color, expected.color,
             "GPU-planned bands change the image"
@@ -412,7 +412,7 @@ fn a_steady_scene_frame_is_one_submission_and_uploads_no_pixels() {
         let image_bytes = u64::from(SCENE_W * SCENE_H) * 16;
         assert_eq!(
             next.stats.readback_bytes,
-            image_bytes + 16,
+            image_bytes + 32,
             "image and band header"
         );
         let passes: Vec<&str> = next

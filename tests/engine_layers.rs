@@ -176,7 +176,7 @@ fn a_steady_peeled_frame_is_one_submission_and_moves_no_layer() {
         assert!(next.stats.upload_bytes <= UPLOAD_BOUND);
         assert_eq!(
             next.stats.readback_bytes,
-            image_bytes + 16,
+            image_bytes + 32,
             "image and band header"
         );
         assert_eq!(next.color, first.color);

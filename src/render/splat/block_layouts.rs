@@ -93,7 +93,10 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
             "merge",
             RENDER_SPLAT_MERGE_COMP,
             Some(5),
-            Some(layout_of!(MergePush { block_size })),
+            Some(layout_of!(MergePush {
+                block_size,
+                blur_per_block
+            })),
         ),
         ("tile count", RENDER_SPLAT_TILE_COUNT_COMP, Some(5), None),
         (
