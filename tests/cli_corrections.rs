@@ -85,7 +85,7 @@ fn prescription_to_eye_to_prescription_closes() {
     let dir = temp_dir("loop");
     let eye = dir.join("rx.toml");
     let eye = eye.to_str().unwrap();
-    // The estimated eye's wavefront is this prescription at its entrance pupil.
+    // The prescription is a spectacle at the default 12 mm vertex distance (issue 29).
     let (s, c, a) = (-2.5, -1.25, 30.0);
     let o = ocular(&[
         "eye",
@@ -118,7 +118,10 @@ fn prescription_to_eye_to_prescription_closes() {
         let ep = r["eye_entrance_pupil_z_mm"].as_f64().unwrap();
         let d = (vertex.parse::<f64>().unwrap() + ep) * 1e-3;
         let f = |k: f64| k / (1.0 + d * k);
-        let (f1, f2) = (f(s), f(s + c));
+        // the meridians at the pupil, from the lens 12 mm in front of the cornea
+        let d12 = (12.0 + ep) * 1e-3;
+        let at_pupil = |p: f64| p / (1.0 - d12 * p);
+        let (f1, f2) = (f(at_pupil(s)), f(at_pupil(s + c)));
         let got_s = r["sphere_d"].as_f64().unwrap();
         let got_c = r["cylinder_d"].as_f64().unwrap();
         let got_a = r["axis_deg"].as_f64().unwrap();

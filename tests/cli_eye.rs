@@ -81,12 +81,23 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
         "--pupil-mm",
         "4",
         "--wavelength-nm",
-        "555",
+        "549",
         "--json",
     ])))
     .unwrap();
+    // "-3 -1 x 20" is a spectacle 12 mm in front of the cornea (taken at 549 nm): its
+    // meridians −3 and −4 D reach the entrance pupil as P/(1 − dP), d = 12 mm + the pupil's
+    // depth (which `eye refract` reports).
+    let r: serde_json::Value =
+        serde_json::from_str(&ok(&ocular(&["eye", "refract", &s(&eye), "--json"]))).unwrap();
+    let d = (12.0 + r["eye_entrance_pupil_z_mm"].as_f64().unwrap()) * 1e-3;
+    let at_pupil = |p: f64| p / (1.0 - d * p);
+    let expected = 0.5 * (at_pupil(-3.0) + at_pupil(-4.0));
     let mm = m["refraction"]["m"].as_f64().unwrap();
-    assert!((mm + 3.5).abs() < 0.05, "M = {mm}");
+    assert!(
+        (mm - expected).abs() < 0.05,
+        "M = {mm}, expected {expected}"
+    );
     // PNG plot of the same run.
     ok(&ocular(&[
         "eye",

@@ -330,7 +330,8 @@ fn graphics_pipeline_checks_its_framebuffers() {
         ],
     )
     .bindings(&[BindingKind::UniformBuffer, BindingKind::SampledImage])
-    .push_constants::<[f32; 8]>()
+    // albedo, emission and the depth range (raster_shade.glsl)
+    .push_constants::<[f32; 12]>()
     .samples(4)
     .color_target(TexelFormat::Rgba16Float, true)
     .color_target(TexelFormat::R32Float, false)

@@ -15,7 +15,7 @@ layout(binding = 2) uniform sampler2D previous_depth;
 void main() {
     float previous = texelFetch(previous_depth, ivec2(gl_FragCoord.xy), 0).r;
     float gap_d = frame.ambient.w;
-    if (!(previous > 0.0) || isinf(previous) || 1.0 / view_depth > 1.0 / previous - gap_d) {
+    if (!(previous > 0.0) || isinf(previous) || 1.0 / fragment_view_depth() > 1.0 / previous - gap_d) {
         discard;
     }
     if (dot(world_normal, frame.camera_position.xyz - world_position) < 0.0) {

@@ -10,8 +10,11 @@ use std::sync::Arc;
 use super::outputs::Outputs;
 use super::write_atomic;
 use crate::aberrations::{self, ZernikeSet};
+use crate::eye::correction::DEFAULT_VERTEX_MM;
 use crate::eye::estimate::{self, Estimate, Method, Progress, Settings};
+use crate::eye::refract::{spectacle_to_pupil_rx, REFRACTION_WAVELENGTH_NM};
 use crate::eye::{self, file as eye_file};
+use crate::optics::zernike::Prescription;
 use crate::{Error, Result};
 
 #[derive(Debug, Args)]
@@ -44,9 +47,14 @@ pub struct EstimateArgs {
     /// Aberration preset (see `ocular eye list`).
     #[arg(long, value_name = "NAME", conflicts_with = "rx")]
     pub preset: Option<String>,
-    /// Spectacle prescription "S C x A" (dioptres, axis in degrees); needs --pupil-mm.
+    /// Spectacle prescription "S C x A" (dioptres, axis in degrees) at --vertex-mm in front
+    /// of the cornea, as --correct and `eye refract` read it; needs --pupil-mm.
     #[arg(long, value_name = "\"S C x A\"", allow_hyphen_values = true)]
     pub rx: Option<String>,
+    /// Vertex distance of --rx, lens to cornea, in mm (0 to 16; 0 = contact lens; default 12,
+    /// the same as --correct's).
+    #[arg(long, value_name = "MM", requires = "rx", value_parser = super::correction::parse_vertex_option, allow_hyphen_values = true)]
+    pub vertex_mm: Option<f64>,
     /// Extra higher-order terms for --rx: "n,m,µm" (repeatable).
     #[arg(
         long = "term",
@@ -58,7 +66,8 @@ pub struct EstimateArgs {
     /// Pupil diameter of the measurement (mm, 1–9); with a file it replaces the file's value.
     #[arg(long)]
     pub pupil_mm: Option<f64>,
-    /// Wavelength of the measurement (nm); default: the file's, or 555 nm for --rx.
+    /// Wavelength of the measurement (nm); default: the file's, or for --rx 549 nm (the
+    /// wavelength the renderer accommodates at and `eye refract` measures at).
     #[arg(long)]
     pub wavelength_nm: Option<f64>,
     /// Where to write the eye file (TOML).
@@ -175,8 +184,10 @@ fn check_pupil(p: f64) -> Result<()> {
         .map_err(Error::input)
 }
 
-/// The target wavefront from the options, and a one-line description of its source.
-fn target(a: &EstimateArgs) -> Result<(ZernikeSet, String)> {
+/// The target wavefront from the options, and a one-line description of its source. A
+/// prescription is moved from its vertex distance to an entrance pupil
+/// `pupil_behind_cornea_mm` behind the cornea (the fitted eye's, see [`run_estimate`]).
+fn target(a: &EstimateArgs, pupil_behind_cornea_mm: f64) -> Result<(ZernikeSet, String)> {
     if !a.terms.is_empty() && a.rx.is_none() {
         return Err(Error::input(
             "--term adds higher-order terms to --rx \"S C x A\"; a --zernike file or --preset \
@@ -213,14 +224,28 @@ fn target(a: &EstimateArgs) -> Result<(ZernikeSet, String)> {
         let pupil = a.pupil_mm.ok_or_else(|| {
             Error::input("--rx needs --pupil-mm (the pupil the prescription's wavefront covers)")
         })?;
-        let mut set = estimate::prescription_target(rx, pupil, a.wavelength_nm.unwrap_or(555.0))
-            .map_err(|e| Error::input(format!("--rx: {e}")))?;
+        let p = Prescription::parse(rx).map_err(|e| Error::input(format!("--rx: {e}")))?;
+        let vertex_mm = rx_vertex_mm(a);
+        let (s, c, axis) = spectacle_to_pupil_rx(
+            p.sphere_d,
+            p.cylinder_d,
+            p.axis_deg,
+            vertex_mm,
+            pupil_behind_cornea_mm,
+        )
+        .map_err(|e| Error::input(format!("--rx {rx:?}: {e}")))?;
+        let [cm, c0, cp] = Prescription::new(s, c, axis).to_zernike(pupil);
+        let mut coefficients = vec![(2, -2, cm), (2, 0, c0), (2, 2, cp)];
         for t in &a.terms {
-            set.coefficients.push(parse_term(t)?);
+            coefficients.push(parse_term(t)?);
         }
         (
-            set,
-            format!("ocular eye estimate --rx \"{rx}\" --pupil-mm {pupil}"),
+            ZernikeSet {
+                pupil_diameter_mm: pupil,
+                wavelength_nm: a.wavelength_nm.unwrap_or(REFRACTION_WAVELENGTH_NM),
+                coefficients,
+            },
+            format!("ocular eye estimate --rx \"{rx}\" --vertex-mm {vertex_mm} --pupil-mm {pupil}"),
         )
     } else {
         return Err(Error::input(
@@ -250,8 +275,32 @@ fn parse_term(t: &str) -> Result<(u32, i32, f64)> {
     Ok((n, m, v))
 }
 
+fn rx_vertex_mm(a: &EstimateArgs) -> f64 {
+    a.vertex_mm.unwrap_or(DEFAULT_VERTEX_MM)
+}
+
+/// Where the estimate of a prescription assumes the entrance pupil lies, and how close the
+/// fitted eye's must come (mm). A millimetre moves a −6 D meridian at the pupil by 0.04 D.
+const RX_PUPIL_TOLERANCE_MM: f64 = 0.01;
+const RX_FITS: usize = 3;
+
+/// The paraxial entrance-pupil depth (mm behind the cornea) of `eye` at `wavelength_nm`.
+fn entrance_pupil_mm(eye: &eye::Eye, wavelength_nm: f64) -> Result<f64> {
+    let sys = eye.system().map_err(Error::Eye)?;
+    Ok(crate::eye::paraxial::paraxial(&sys, wavelength_nm, 0.0).entrance_pupil_z_mm)
+}
+
 fn run_estimate(a: &EstimateArgs) -> Result<()> {
-    let (target, command) = target(a)?;
+    // A prescription's wavefront depends on where the fitted eye's entrance pupil lies: start
+    // from the estimator's own start eye and fit again while the fitted eye's pupil moved.
+    let wavelength_nm = a.wavelength_nm.unwrap_or(REFRACTION_WAVELENGTH_NM);
+    let mut pupil_depth_mm =
+        if a.rx.is_some() && crate::limits::WAVELENGTH_NM.contains(wavelength_nm) {
+            entrance_pupil_mm(&estimate::params::prior_centre(), wavelength_nm)?
+        } else {
+            0.0
+        };
+    let (mut target, command) = target(a, pupil_depth_mm)?;
     let mut outputs = Outputs::new();
     outputs.add("-o", &a.output, &["toml"])?;
     if let Some(p) = &a.json {
@@ -301,14 +350,27 @@ fn run_estimate(a: &EstimateArgs) -> Result<()> {
             ));
         }
     };
-    let result = estimate::estimate(&target, &settings, &cancel, &mut progress);
+    let mut fits = 0;
+    let est = loop {
+        let result = estimate::estimate(&target, &settings, &cancel, &mut progress);
+        let est = result.map_err(|e| match e {
+            estimate::EstimateError::Input(m) => Error::Input(m),
+            estimate::EstimateError::Eye(e) => Error::Eye(e),
+        })?;
+        fits += 1;
+        if a.rx.is_none() || fits == RX_FITS || cancel.load(Ordering::SeqCst) {
+            break est;
+        }
+        let fitted_mm = entrance_pupil_mm(&est.eye, target.wavelength_nm)?;
+        if (fitted_mm - pupil_depth_mm).abs() < RX_PUPIL_TOLERANCE_MM {
+            break est;
+        }
+        pupil_depth_mm = fitted_mm;
+        target = self::target(a, pupil_depth_mm)?.0;
+    };
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let est = result.map_err(|e| match e {
-        estimate::EstimateError::Input(m) => Error::Input(m),
-        estimate::EstimateError::Eye(e) => Error::Eye(e),
-    })?;
     write_outputs(a, &est, &command, &outputs)?;
     outputs.commit()?;
     let r = &est.report;

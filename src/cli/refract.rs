@@ -20,7 +20,7 @@ pub struct RefractArgs {
     pub vertex_mm: f64,
     /// Wavelength of the refraction in nm (380 to 1000; default: the wavelength the renderer
     /// accommodates at).
-    #[arg(long, default_value_t = 549.0, value_parser = parse_wavelength_nm, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = crate::eye::refract::REFRACTION_WAVELENGTH_NM, value_parser = parse_wavelength_nm, allow_hyphen_values = true)]
     pub wavelength_nm: f64,
     /// Print JSON (sphere_d, cylinder_d, axis_deg, rx, and the measurement behind them).
     #[arg(long)]

@@ -38,7 +38,7 @@ pub struct Spectacle {
     /// ≤ 0 (minus-cylinder form).
     #[serde(default)]
     pub cylinder_d: f64,
-    /// 1–180°.
+    /// 0–180° (typed: 1–180°).
     #[serde(default = "default_axis")]
     pub axis_deg: f64,
     /// Lens to corneal vertex (mm); 0 = contact lens.
@@ -142,10 +142,13 @@ impl Spectacle {
             (-10.0, 0.0),
             "D (minus cylinder)",
         )?;
+        // Typed prescriptions keep the clinical 1–180 (parse_rx); a computed lens may have
+        // any orientation, and 0–1° is as real as 1–180° (eye refract's lens for an eye
+        // with a tiny cylinder landed at 0.45°).
         in_range(
             "correction.axis_deg",
             self.axis_deg,
-            (1.0, 180.0),
+            (0.0, 180.0),
             "degrees",
         )?;
         in_range(

@@ -66,6 +66,38 @@ pub fn rx_to_power_vector(sphere_d: f64, cylinder_d: f64, axis_deg: f64) -> [f64
     ]
 }
 
+/// The wavelength (nm) a prescription is taken at unless one is given: the one the renderer
+/// accommodates at, so that a lens written by `eye refract` and read by `--correct` focuses
+/// the rendered image.
+pub const REFRACTION_WAVELENGTH_NM: f64 = 549.0;
+
+/// The refraction at the eye's entrance pupil, `pupil_behind_cornea_mm` behind the cornea,
+/// that a spectacle prescription `vertex_mm` in front of the cornea corrects: the inverse of
+/// [`refract`]'s first estimate. Each principal meridian's power F at the lens moves to
+/// K = F/(1 − dF) at the pupil, d from the lens to the pupil. Sphere, minus cylinder, axis.
+pub fn spectacle_to_pupil_rx(
+    sphere_d: f64,
+    cylinder_d: f64,
+    axis_deg: f64,
+    vertex_mm: f64,
+    pupil_behind_cornea_mm: f64,
+) -> Result<(f64, f64, f64), String> {
+    let d_m = (vertex_mm + pupil_behind_cornea_mm) * 1e-3;
+    let carry = |f: f64| -> Result<f64, String> {
+        let denominator = 1.0 - d_m * f;
+        // A meridian this strong focuses light before it reaches the eye.
+        if denominator < 0.1 {
+            return Err(format!(
+                "a {f:+.2} D meridian {vertex_mm} mm in front of the cornea focuses light in                  front of the eye; no eye has that refraction"
+            ));
+        }
+        Ok(f / denominator)
+    };
+    let (k1, k2) = (carry(sphere_d)?, carry(sphere_d + cylinder_d)?);
+    let pv = rx_to_power_vector(k1, k2 - k1, axis_deg);
+    Ok(power_vector_to_rx(pv[0], pv[1], pv[2]))
+}
+
 fn measure_far(
     eye: &Eye,
     pupil_mm: f64,
@@ -143,5 +175,61 @@ mod tests {
         // J0 = −(C/2)·cos 2A: a −1 D cylinder at 90° has J0 = −0.5 D.
         let pv = rx_to_power_vector(0.0, -1.0, 90.0);
         assert!((pv[1] + 0.5).abs() < 1e-12);
+    }
+
+    /// Power matrix of sphere S along axis A and S + C across it.
+    fn power_matrix(s: f64, c: f64, a_deg: f64) -> [[f64; 2]; 2] {
+        let (sa, ca) = a_deg.to_radians().sin_cos();
+        // across the axis: the unit vector (−sin A, cos A)
+        [
+            [s + c * sa * sa, -c * sa * ca],
+            [-c * sa * ca, s + c * ca * ca],
+        ]
+    }
+
+    /// Against the far point: a meridian of power F at the lens images infinity 1/F in front
+    /// of it, so at a pupil d behind the lens the vergence is 1/(1/F − d). For an oblique
+    /// cylinder each principal meridian (an eigenvector of the power matrix) moves on its own,
+    /// and the matrix rebuilt from the moved eigenvalues is the result's.
+    #[test]
+    fn spectacle_meridians_move_to_the_pupil_by_their_far_points() {
+        let (vertex_mm, pupil_mm) = (12.0, 3.1);
+        let d_m = (vertex_mm + pupil_mm) * 1e-3;
+        for (s, c, a) in [
+            (-6.0, 0.0, 180.0),
+            (4.0, 0.0, 180.0),
+            (-2.25, -1.5, 35.0),
+            (2.5, -1.75, 135.0),
+            (-3.0, -2.0, 60.0),
+        ] {
+            let (ks, kc, ka) = spectacle_to_pupil_rx(s, c, a, vertex_mm, pupil_mm).unwrap();
+            let got = power_matrix(ks, kc, ka);
+            let p = power_matrix(s, c, a);
+            // eigen-decomposition of the symmetric 2×2 lens matrix
+            let mean = 0.5 * (p[0][0] + p[1][1]);
+            let half = (0.25 * (p[0][0] - p[1][1]).powi(2) + p[0][1] * p[0][1]).sqrt();
+            let theta = 0.5 * (2.0 * p[0][1]).atan2(p[0][0] - p[1][1]);
+            let (st, ct) = theta.sin_cos();
+            let far = |f: f64| 1.0 / (1.0 / f - d_m);
+            let (l1, l2) = (far(mean + half), far(mean - half));
+            let want = [
+                [l1 * ct * ct + l2 * st * st, (l1 - l2) * st * ct],
+                [(l1 - l2) * st * ct, l1 * st * st + l2 * ct * ct],
+            ];
+            for i in 0..2 {
+                for j in 0..2 {
+                    assert!(
+                        (got[i][j] - want[i][j]).abs() < 1e-9,
+                        "{s} {c} x {a}: {got:?} vs {want:?}"
+                    );
+                }
+            }
+            // and back: refract's first estimate is the inverse
+            let carry = |k: f64| k / (1.0 + d_m * k);
+            let (b1, b2) = (carry(ks), carry(ks + kc));
+            assert!((b1 - s).abs() < 1e-9 && (b2 - (s + c)).abs() < 1e-9);
+        }
+        // a 60 D meridian at 20 mm focuses 16.7 mm from the lens, before the pupil
+        assert!(spectacle_to_pupil_rx(40.0, 20.0, 90.0, 16.0, 4.0).is_err());
     }
 }

@@ -78,6 +78,9 @@ struct FrameUniform {
 struct MaterialPush {
     albedo: [f32; 4],
     emission: [f32; 4],
+    /// x, y: the nearest and farthest view depth (m) of the batch's box within the clip range
+    /// (see raster_shade.glsl).
+    depth_range_m: [f32; 4],
 }
 
 #[repr(C)]
@@ -596,6 +599,8 @@ impl Rasterizer {
             )
         };
         let far = state.camera.far_m as f32;
+        let (eye_m, forward) = (state.camera.position_m, state.camera.forward());
+        let (clip_near_m, clip_far_m) = (state.camera.near_m, state.camera.far_m);
         let materials = &state.scene.geometry.materials;
         rec.begin_pass("raster");
         rec.begin_render_pass(pipeline, framebuffer, &[clear, [far, 0.0, 0.0, 0.0]], 0.0)?;
@@ -618,6 +623,13 @@ impl Rasterizer {
                     material.emission[2],
                     0.0,
                 ],
+                depth_range_m: {
+                    let (lo, hi) = batch.view_depth_range_m(eye_m, forward);
+                    // clipping keeps every fragment inside [near, far]
+                    let lo = lo.max(clip_near_m);
+                    let hi = hi.min(clip_far_m).max(lo);
+                    [lo as f32, hi as f32, 0.0, 0.0]
+                },
             };
             let bindings = [
                 Binding::Buffer(&self.uniforms),

@@ -43,12 +43,35 @@ pub struct Texture {
     pub source: String,
 }
 
-/// `index_count` indices from `first_index` drawn with one material.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// `index_count` indices from `first_index` drawn with one material: one placed object (or
+/// one material of it), with the world-space box that holds its vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Batch {
     pub first_index: u32,
     pub index_count: u32,
     pub material: usize,
+    /// Smallest and largest corner of the axis-aligned box around the batch's vertices (m).
+    pub bounds_m: [[f64; 3]; 2],
+}
+
+impl Batch {
+    /// The nearest and farthest distance along `forward_unit` from `eye_m` of any point of the
+    /// batch's box. Depth along a direction is linear in position, so its extremes over a box
+    /// are at corners.
+    pub fn view_depth_range_m(&self, eye_m: [f64; 3], forward_unit: [f64; 3]) -> (f64, f64) {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for corner in 0..8 {
+            let d: f64 = (0..3)
+                .map(|k| {
+                    let p = self.bounds_m[(corner >> k) & 1][k];
+                    (p - eye_m[k]) * forward_unit[k]
+                })
+                .sum();
+            lo = lo.min(d);
+            hi = hi.max(d);
+        }
+        (lo, hi)
+    }
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -236,8 +259,15 @@ impl Geometry {
         }
         let normal_matrix = DMat3::from_mat4(*model).inverse().transpose();
         let base = self.vertices.len() as u32;
+        let mut bounds_m = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
         for i in 0..mesh.positions.len() {
             let p = model.transform_point3(DVec3::from(mesh.positions[i]));
+            // the box holds the stored (f32) positions, which the GPU sees
+            let stored = p.as_vec3().to_array();
+            for k in 0..3 {
+                bounds_m[0][k] = bounds_m[0][k].min(f64::from(stored[k]));
+                bounds_m[1][k] = bounds_m[1][k].max(f64::from(stored[k]));
+            }
             let n = (normal_matrix * DVec3::from(mesh.normals[i])).normalize_or_zero();
             self.vertices.push(Vertex {
                 position_m: p.as_vec3().to_array(),
@@ -247,23 +277,75 @@ impl Geometry {
         }
         let first_index = self.indices.len() as u32;
         self.indices.extend(mesh.indices.iter().map(|i| i + base));
-        let index_count = mesh.indices.len() as u32;
-        match self.batches.last_mut() {
-            Some(last)
-                if last.material == material
-                    && last.first_index + last.index_count == first_index =>
-            {
-                last.index_count += index_count;
-            }
-            _ => self.batches.push(Batch {
-                first_index,
-                index_count,
-                material,
-            }),
-        }
+        // One batch per placement, never merged with its neighbours: the rasteriser bounds each
+        // fragment's depth by its batch's box, and a batch spanning a row of columns would
+        // loosen that bound to the whole row.
+        self.batches.push(Batch {
+            first_index,
+            index_count: mesh.indices.len() as u32,
+            material,
+            bounds_m,
+        });
     }
 
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The depth range of a placed cuboid, against its eight corners' depths computed from the
+    /// placement itself: an axis-aligned box is its own bounding box, so the range is exact;
+    /// a rotated one's range must hold every vertex.
+    #[test]
+    fn batch_depth_range_holds_every_vertex_and_is_exact_for_a_box() {
+        let eye = [0.3, 1.2, 2.0];
+        let forward = {
+            let f = DVec3::new(0.2, -0.3, -1.0).normalize();
+            [f.x, f.y, f.z]
+        };
+        let depth = |p: [f32; 3]| -> f64 {
+            (0..3)
+                .map(|k| (f64::from(p[k]) - eye[k]) * forward[k])
+                .sum()
+        };
+        for (rotate, exact) in [([0.0; 3], true), ([20.0, 35.0, -10.0], false)] {
+            let mut g = Geometry::default();
+            g.add(
+                &cuboid([0.5, 1.0, 2.0]),
+                &model_matrix([1.0, 0.5, -3.0], rotate, [1.0; 3]),
+                0,
+            );
+            g.add(
+                &sphere(0.2, 12),
+                &model_matrix([0.0, 0.0, -8.0], [0.0; 3], [1.0; 3]),
+                0,
+            );
+            assert_eq!(g.batches.len(), 2, "one batch per placement");
+            let b = g.batches[0];
+            let (lo, hi) = b.view_depth_range_m(eye, forward);
+            let used: Vec<f64> = g.indices[..b.index_count as usize]
+                .iter()
+                .map(|&i| depth(g.vertices[i as usize].position_m))
+                .collect();
+            let (vlo, vhi) = used
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &d| {
+                    (a.min(d), b.max(d))
+                });
+            assert!(
+                lo <= vlo + 1e-12 && hi >= vhi - 1e-12,
+                "{lo}..{hi} vs {vlo}..{vhi}"
+            );
+            if exact {
+                assert!((lo - vlo).abs() < 1e-9 && (hi - vhi).abs() < 1e-9);
+            }
+            // the second placement has its own, farther box
+            let (lo2, _) = g.batches[1].view_depth_range_m(eye, forward);
+            assert!(lo2 > hi, "{lo2} vs {hi}");
+        }
     }
 }
