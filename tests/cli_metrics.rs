@@ -290,3 +290,129 @@ fn bad_input_is_refused_with_exit_2() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `compare`'s FLIP column judges the displayed images (linear × 2^EV, clamped) of each row
+/// against the truth's at --flip-ppd: a judged file's value is LDR-FLIP of exactly those.
+#[test]
+fn compare_reports_flip_of_the_displayed_images() {
+    use ocular::metrics::flip::{ldr_flip, FlipStats};
+    use ocular::metrics::ImageView;
+    let dir = scratch("compare");
+    let (w, h) = (96usize, 54usize);
+    let truth: Vec<f32> = (0..w * h * 3)
+        .map(|i| {
+            let (p, c) = (i / 3, i % 3);
+            let (x, y) = ((p % w) as f32, (p / w) as f32);
+            0.2 + 0.15 * ((x * 0.3 + c as f32).sin() + (y * 0.2).cos())
+                + if (p % w) > 40 { 0.3 } else { 0.0 }
+        })
+        .collect();
+    let judged: Vec<f32> = truth
+        .iter()
+        .enumerate()
+        .map(|(i, v)| v * if (i / 3) % 7 == 0 { 1.3 } else { 0.97 })
+        .collect();
+    let (t, j, report) = (
+        dir.join("truth.exr"),
+        dir.join("judged.exr"),
+        dir.join("c.json"),
+    );
+    exr(&t, &truth, (w, h));
+    exr(&j, &judged, (w, h));
+    let cache = dir.join("cache");
+    std::fs::create_dir_all(&cache).unwrap();
+    let out = ocular()
+        .args([
+            "compare",
+            "--size",
+            "96x54",
+            "--no-slices",
+            "--no-warmup",
+            "--flip-ppd",
+            "40",
+        ])
+        .args([
+            "--truth-in",
+            s(&t),
+            "--judge",
+            s(&j),
+            "--json",
+            s(&report),
+            "--cache",
+            s(&cache),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("FLIP"), "{table}");
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(v["flip_ppd"].as_f64(), Some(40.0));
+    let ev = v["display_exposure_ev"].as_f64().unwrap() as f32;
+    let shown = |rgb: &[f32]| -> Vec<[f32; 4]> {
+        let k = ev.exp2();
+        rgb.chunks_exact(3)
+            .map(|p| {
+                [
+                    (p[0] * k).clamp(0.0, 1.0),
+                    (p[1] * k).clamp(0.0, 1.0),
+                    (p[2] * k).clamp(0.0, 1.0),
+                    1.0,
+                ]
+            })
+            .collect()
+    };
+    let (a, b) = (shown(&truth), shown(&judged));
+    let expected = |ppd: f64| {
+        FlipStats::of(&ldr_flip(
+            ImageView::new(w, h, &a),
+            ImageView::new(w, h, &b),
+            ppd,
+        ))
+        .mean
+    };
+    let row = |name: &str| {
+        v["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == name)
+            .unwrap()["flip_mean"]
+            .as_f64()
+            .unwrap()
+    };
+    assert_eq!(row("reference"), 0.0);
+    let got = row("judged");
+    assert!(
+        (got - expected(40.0)).abs() < 1e-9,
+        "{got} against {}",
+        expected(40.0)
+    );
+    // the controls: the default ppd, and the raw linear values instead of the displayed ones
+    assert!((got - expected(ocular::metrics::flip::DEFAULT_PPD)).abs() > 1e-4);
+    let raw = |rgb: &[f32]| -> Vec<[f32; 4]> {
+        rgb.chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2], 1.0])
+            .collect()
+    };
+    let (ra, rb) = (raw(&truth), raw(&judged));
+    let undisplayed = FlipStats::of(&ldr_flip(
+        ImageView::new(w, h, &ra),
+        ImageView::new(w, h, &rb),
+        40.0,
+    ))
+    .mean;
+    assert!((got - undisplayed).abs() > 1e-4, "{got} {undisplayed}");
+    assert!(row("splat") > 0.0 && row("splat") < 1.0);
+    // a bad --flip-ppd is refused before any work
+    let bad = ocular()
+        .args(["compare", "--flip-ppd", "0"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(dir);
+}
