@@ -310,7 +310,7 @@ fn compare_reports_flip_of_the_displayed_images() {
     let judged: Vec<f32> = truth
         .iter()
         .enumerate()
-        .map(|(i, v)| v * if (i / 3) % 7 == 0 { 1.3 } else { 0.97 })
+        .map(|(i, v)| v * if (i / 3).is_multiple_of(7) { 1.3 } else { 0.97 })
         .collect();
     let (t, j, report) = (
         dir.join("truth.exr"),

@@ -233,7 +233,11 @@ fn patterns(w: usize, h: usize) -> Vec<(&'static str, Vec<u8>, Vec<u8>)> {
         out
     };
     let bars = |x: usize, y: usize, c: usize| -> f64 {
-        let stripe = if (x / 3 + y / 5) % 2 == 0 { 0.85 } else { 0.15 };
+        let stripe = if (x / 3 + y / 5).is_multiple_of(2) {
+            0.85
+        } else {
+            0.15
+        };
         stripe * [1.0, 0.7, 0.4][c] + 0.1 * (x as f64 / w as f64)
     };
     let reference = make(&mut |x, y, c| bars(x, y, c));
