@@ -407,7 +407,7 @@ fn print_table(r: &Report) {
     } else {
         format!("{:.2}", r.psnr_db)
     };
-    println!("  PSNR      {db:>9} dB (peak {})", r.psnr_peak);
+    println!("  PSNR      {db:>9} dB (peak {:.4})", r.psnr_peak);
     let window = if r.ssim_window_px == 11 {
         String::new()
     } else {
@@ -424,8 +424,15 @@ fn print_table(r: &Report) {
     );
     if let (Some(tm), Some(e)) = (r.flip.tone_mapper, r.flip.exposures) {
         println!(
-            "  HDR-FLIP exposures {:+.3} to {:+.3} stops, {} of them, tone mapper {tm:?}",
-            e.start, e.stop, e.count
+            "  HDR-FLIP exposures {:+.3} to {:+.3} stops, {} of them, tone mapper {}",
+            e.start,
+            e.stop,
+            e.count,
+            match tm {
+                ToneMapper::Aces => "ACES",
+                ToneMapper::Hable => "Hable",
+                ToneMapper::Reinhard => "Reinhard",
+            }
         );
     }
 }
