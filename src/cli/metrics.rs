@@ -337,11 +337,15 @@ pub fn run(args: &MetricsArgs) -> Result<()> {
             &settings,
         )
         .map_err(|e| {
-            let hint = match e {
-                flip::hdr::HdrError::NoAutomaticRange => " (--start-exposure and --stop-exposure)",
-                _ => "",
-            };
-            Error::input(format!("{}: {e}{hint}", args.reference.display()))
+            Error::input(match e {
+                flip::hdr::HdrError::NoAutomaticRange => format!(
+                    "{}: {e} (--start-exposure and --stop-exposure)",
+                    args.reference.display()
+                ),
+                flip::hdr::HdrError::BadRange(_) => {
+                    format!("--start-exposure / --stop-exposure / --exposures: {e}")
+                }
+            })
         })?;
         (result.map, Some(result.range))
     } else {

@@ -25,8 +25,8 @@ impl Plane {
         self.values[y * self.width + x]
     }
 
-    /// Correlation along rows with `taps` (odd length, centred), then along columns with
-    /// `taps_y`: out(x, y) = Σ_j Σ_i taps_y[j] taps_x[i] in(x + i − r, y + j − r).
+    /// Correlation along rows with `taps_x`, then along columns with `taps_y` (each of odd
+    /// length, centred): out(x, y) = Σ_j Σ_i taps_y[j] taps_x[i] in(x + i − r_x, y + j − r_y).
     pub fn separable(&self, taps_x: &[f64], taps_y: &[f64]) -> Plane {
         self.along_rows(taps_x).along_columns(taps_y)
     }
