@@ -12,6 +12,8 @@
 //! computed with the largest odd window that fits (σ scaled with it), and `Ssim::window_px`
 //! says which, so a caller can report it rather than print a number on another scale.
 
+pub mod flip;
+
 /// Radius of the 11×11 window.
 pub const WINDOW_RADIUS: usize = 5;
 const SIGMA: f64 = 1.5;

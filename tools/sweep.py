@@ -4,7 +4,7 @@
 Renders one ground truth with `ocular compare` (default settings), then varies one setting at a
 time around the defaults — object-distance samples, Rmax cap, merge thresholds, tile size, PSF
 texture format, beta degree, PSF pitch — and records the splat image's quality against that
-fixed truth (PSNR, MSSIM) and its GPU time. Writes a CSV and a plot of quality against time with
+fixed truth (PSNR, MSSIM, mean FLIP at FLIP's default 67 pixels per degree) and its GPU time. Writes a CSV and a plot of quality against time with
 the defaults marked.
 
     tools/sweep.py                       # primitives, myopia eye, 320x180 → sweep/
@@ -79,21 +79,21 @@ def main():
     print(f"ground truth: {args.scene}, eye {args.eye}, {args.size} (default settings)", flush=True)
     baseline, _ = compare(args, ["--truth-out", truth], scratch)
     rows = [{"setting": "defaults", "value": "", "psnr_db": baseline["psnr_db"], "mssim": baseline["mssim"],
-             "gpu_ms": baseline["gpu_ms"], "default": True}]
+             "flip": baseline["flip_mean"], "gpu_ms": baseline["gpu_ms"], "default": True}]
     for name, flag, values in SWEEP:
         for value in values:
             if value == DEFAULTS[flag]:
                 continue
             splat, seconds = compare(args, ["--truth-in", truth, flag, value], scratch)
             rows.append({"setting": name, "value": value, "psnr_db": splat["psnr_db"], "mssim": splat["mssim"],
-                         "gpu_ms": splat["gpu_ms"], "default": False})
+                         "flip": splat["flip_mean"], "gpu_ms": splat["gpu_ms"], "default": False})
             print(f"  {name:<24} {value:>8}: {splat['psnr_db'] or float('inf'):7.2f} dB  MSSIM {splat['mssim']:.5f}  "
-                  f"GPU {splat['gpu_ms']:9.2f} ms  ({seconds:.0f} s)", flush=True)
+                  f"FLIP {splat['flip_mean']:.4f}  GPU {splat['gpu_ms']:9.2f} ms  ({seconds:.0f} s)", flush=True)
     os.remove(scratch)
 
     csv_path = os.path.join(args.out, "sweep.csv")
     with open(csv_path + ".tmp", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=["setting", "value", "psnr_db", "mssim", "gpu_ms", "default"])
+        writer = csv.DictWriter(f, fieldnames=["setting", "value", "psnr_db", "mssim", "flip", "gpu_ms", "default"])
         writer.writeheader()
         writer.writerows(rows)
     os.replace(csv_path + ".tmp", csv_path)

@@ -12,6 +12,7 @@ use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::metrics::flip::{ldr_flip, FlipStats};
 use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
 use crate::render::frame::{FrameRenderer, Method, RenderedFrame};
 use crate::render::splat::FrameInput;
@@ -24,7 +25,7 @@ use crate::{Error, Result};
     ocular compare --scene primitives --eye keratoconus --json kc.json --maps maps/\n\n\
 Quality is measured against the ground truth on the displayed image: linear values at the input \
 frame's automatic exposure, clamped to [0, 1] (PSNR with a peak of 1; SSIM with Wang et al.'s \
-settings; in JSON a PSNR of null means identical images). The ground truth computes one exact PSF per 0.001 D \
+settings; FLIP is LDR-FLIP at --flip-ppd; in JSON a PSNR of null means identical images). The ground truth computes one exact PSF per 0.001 D \
 bin and channel, on the CPU: it is slow by design.")]
 pub struct CompareArgs {
     /// Built-in scene or a scene .toml file (rendered at t = 0).
@@ -108,6 +109,10 @@ pub struct CompareArgs {
     /// Neither read nor write the kernel cache.
     #[arg(long)]
     pub no_cache: bool,
+    /// Viewing condition of the FLIP column in pixels per degree (default: FLIP's 67.02,
+    /// 0.7 m from a 0.7 m wide monitor 3840 pixels across).
+    #[arg(long, value_name = "N", default_value_t = crate::metrics::flip::DEFAULT_PPD)]
+    pub flip_ppd: f64,
 }
 
 /// Which image the others are judged against.
@@ -139,6 +144,8 @@ pub struct MethodResult {
     pub psnr_db: f64,
     pub mssim: f64,
     pub speedup_vs_reference: f64,
+    /// Mean LDR-FLIP of the displayed image against the truth's, at the report's `flip_ppd`.
+    pub flip_mean: f64,
     /// GPU time of all passes (splat only).
     pub gpu_ms: Option<f64>,
     /// Depth layers the method saw.
@@ -167,6 +174,10 @@ struct Report {
     views_convergence: Option<ViewsConvergence>,
     /// Whether splat's `seconds` is a second frame (true) or the first (`--no-warmup`).
     splat_warmed_up: bool,
+    /// Pixels per degree of the FLIP column.
+    flip_ppd: f64,
+    /// Exposure (EV) of the displayed images every metric judges: linear × 2^EV, clamped.
+    display_exposure_ev: f32,
     methods: Vec<MethodResult>,
 }
 
@@ -207,6 +218,12 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let splat = args.splat.settings()?;
     if args.views.is_some() && args.truth != TruthArg::Views {
         return Err(Error::input("--views applies to --truth views"));
+    }
+    if !(args.flip_ppd.is_finite() && (1.0..=10_000.0).contains(&args.flip_ppd)) {
+        return Err(Error::input(format!(
+            "--flip-ppd {} is outside 1 to 10000 pixels per degree",
+            args.flip_ppd
+        )));
     }
     if args.slices == 0 {
         return Err(Error::input("--slices must be at least 1"));
@@ -527,6 +544,12 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 1.0,
             ),
             mssim: quality.mean,
+            flip_mean: FlipStats::of(&ldr_flip(
+                ImageView::new(w, h, &truth01),
+                ImageView::new(w, h, &image),
+                args.flip_ppd,
+            ))
+            .mean,
             // a truth read with --truth-in has no time (NaN), nor a speed-up
             speedup_vs_reference: if frame.seconds.is_nan() {
                 f64::NAN
@@ -566,10 +589,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         );
     }
     println!(
-        "  {:<13} {:>10} {:>10} {:>10} {:>12}   edge band ({} px): {:>8} {:>8}",
+        "  {:<13} {:>10} {:>10} {:>8} {:>10} {:>12}   edge band ({} px): {:>8} {:>8}",
         "method",
         "PSNR dB",
         "MSSIM",
+        "FLIP",
         "seconds",
         "× faster",
         methods.first().map_or(0, |m| m.edge_band.pixels),
@@ -597,8 +621,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         };
         let (seconds, speedup) = (shown(m.seconds, 3), shown(m.speedup_vs_reference, 1));
         println!(
-            "  {:<13} {:>10} {:>10.4} {:>10} {:>12}   {:>28} {:>8.4}",
-            m.method, db, m.mssim, seconds, speedup, band_db, m.edge_band.mssim
+            "  {:<13} {:>10} {:>10.4} {:>8.4} {:>10} {:>12}   {:>28} {:>8.4}",
+            m.method, db, m.mssim, m.flip_mean, seconds, speedup, band_db, m.edge_band.mssim
         );
     }
     if let Some(path) = &args.truth_out {
@@ -658,6 +682,8 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
                 .then_some(renderer.reference_dioptre_bin_d),
             views_convergence,
             splat_warmed_up: !args.no_warmup,
+            flip_ppd: args.flip_ppd,
+            display_exposure_ev: exposure_ev,
             methods,
         };
         let text = serde_json::to_string_pretty(&report)

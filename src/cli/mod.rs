@@ -14,6 +14,7 @@ mod eye;
 mod eye_plot;
 mod kernels;
 mod kernels_field;
+mod metrics;
 mod occlusion;
 mod outputs;
 mod psf;
@@ -68,6 +69,8 @@ pub enum Command {
     Kernels(Box<kernels::KernelsArgs>),
     /// Eyes: estimate one from a wavefront or prescription, show, measure, draw, list presets.
     Eye(Box<eye::EyeArgs>),
+    /// PSNR, SSIM and FLIP between two images (HDR-FLIP for EXR), with an error map.
+    Metrics(Box<metrics::MetricsArgs>),
 }
 
 impl Cli {
@@ -111,6 +114,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Psf(args) => refuse_device(&cli, "psf").and_then(|()| psf::run(args)),
         Command::Kernels(args) => refuse_device(&cli, "kernels").and_then(|()| kernels::run(args)),
         Command::Eye(args) => refuse_device(&cli, "eye").and_then(|()| eye::run(args)),
+        Command::Metrics(args) => refuse_device(&cli, "metrics").and_then(|()| metrics::run(args)),
     }
 }
 
