@@ -404,7 +404,7 @@ const WALL_M: f64 = 3.0;
 const PUPIL_MM: f64 = 6.0;
 
 fn stripe(x: usize) -> f32 {
-    if (x / 3) % 2 == 0 {
+    if (x / 3).is_multiple_of(2) {
         0.9
     } else {
         0.1
