@@ -10,11 +10,8 @@ use std::sync::Arc;
 use super::outputs::Outputs;
 use super::write_atomic;
 use crate::aberrations::{self, ZernikeSet};
-use crate::eye::correction::DEFAULT_VERTEX_MM;
-use crate::eye::estimate::{self, Estimate, Method, Progress, Settings};
-use crate::eye::refract::{spectacle_to_pupil_rx, REFRACTION_WAVELENGTH_NM};
+use crate::eye::estimate::{self, Estimate, Method, Progress, RxTarget, Settings};
 use crate::eye::{self, file as eye_file};
-use crate::optics::zernike::Prescription;
 use crate::{Error, Result};
 
 #[derive(Debug, Args)]
@@ -184,10 +181,22 @@ fn check_pupil(p: f64) -> Result<()> {
         .map_err(Error::input)
 }
 
-/// The target wavefront from the options, and a one-line description of its source. A
-/// prescription is moved from its vertex distance to an entrance pupil
-/// `pupil_behind_cornea_mm` behind the cornea (the fitted eye's, see [`run_estimate`]).
-fn target(a: &EstimateArgs, pupil_behind_cornea_mm: f64) -> Result<(ZernikeSet, String)> {
+/// What `eye estimate` fits: a wavefront as given, or a prescription, whose wavefront depends
+/// on the fitted eye (see [`RxTarget`]).
+enum Target {
+    Wavefront(ZernikeSet),
+    Prescription(RxTarget),
+}
+
+fn estimate_error(e: estimate::EstimateError) -> Error {
+    match e {
+        estimate::EstimateError::Input(m) => Error::Input(m),
+        estimate::EstimateError::Eye(e) => Error::Eye(e),
+    }
+}
+
+/// The target from the options, checked, and a one-line description of its source.
+fn target(a: &EstimateArgs) -> Result<(Target, String)> {
     if !a.terms.is_empty() && a.rx.is_none() {
         return Err(Error::input(
             "--term adds higher-order terms to --rx \"S C x A\"; a --zernike file or --preset \
@@ -224,36 +233,24 @@ fn target(a: &EstimateArgs, pupil_behind_cornea_mm: f64) -> Result<(ZernikeSet, 
         let pupil = a.pupil_mm.ok_or_else(|| {
             Error::input("--rx needs --pupil-mm (the pupil the prescription's wavefront covers)")
         })?;
-        let p = Prescription::parse(rx).map_err(|e| Error::input(format!("--rx: {e}")))?;
-        let vertex_mm = rx_vertex_mm(a);
-        let (s, c, axis) = spectacle_to_pupil_rx(
-            p.sphere_d,
-            p.cylinder_d,
-            p.axis_deg,
-            vertex_mm,
-            pupil_behind_cornea_mm,
-        )
-        .map_err(|e| Error::input(format!("--rx {rx:?}: {e}")))?;
-        let [cm, c0, cp] = Prescription::new(s, c, axis).to_zernike(pupil);
-        let mut coefficients = vec![(2, -2, cm), (2, 0, c0), (2, 2, cp)];
-        for t in &a.terms {
-            coefficients.push(parse_term(t)?);
+        let mut t =
+            RxTarget::new(rx, pupil, a.wavelength_nm, a.vertex_mm).map_err(estimate_error)?;
+        for term in &a.terms {
+            t.extra_terms.push(parse_term(term)?);
         }
-        (
-            ZernikeSet {
-                pupil_diameter_mm: pupil,
-                wavelength_nm: a.wavelength_nm.unwrap_or(REFRACTION_WAVELENGTH_NM),
-                coefficients,
-            },
-            format!("ocular eye estimate --rx \"{rx}\" --vertex-mm {vertex_mm} --pupil-mm {pupil}"),
-        )
+        t.start_target().map_err(estimate_error)?;
+        let command = format!(
+            "ocular eye estimate --rx \"{rx}\" --vertex-mm {} --pupil-mm {pupil}",
+            t.vertex_mm
+        );
+        return Ok((Target::Prescription(t), command));
     } else {
         return Err(Error::input(
             "give the wavefront: --zernike FILE, --preset NAME, or --rx \"S C x A\" with --pupil-mm",
         ));
     };
     estimate::check_target(&set.0).map_err(|e| Error::input(e.to_string()))?;
-    Ok(set)
+    Ok((Target::Wavefront(set.0), set.1))
 }
 
 fn parse_term(t: &str) -> Result<(u32, i32, f64)> {
@@ -275,32 +272,8 @@ fn parse_term(t: &str) -> Result<(u32, i32, f64)> {
     Ok((n, m, v))
 }
 
-fn rx_vertex_mm(a: &EstimateArgs) -> f64 {
-    a.vertex_mm.unwrap_or(DEFAULT_VERTEX_MM)
-}
-
-/// Where the estimate of a prescription assumes the entrance pupil lies, and how close the
-/// fitted eye's must come (mm). A millimetre moves a −6 D meridian at the pupil by 0.04 D.
-const RX_PUPIL_TOLERANCE_MM: f64 = 0.01;
-const RX_FITS: usize = 3;
-
-/// The paraxial entrance-pupil depth (mm behind the cornea) of `eye` at `wavelength_nm`.
-fn entrance_pupil_mm(eye: &eye::Eye, wavelength_nm: f64) -> Result<f64> {
-    let sys = eye.system().map_err(Error::Eye)?;
-    Ok(crate::eye::paraxial::paraxial(&sys, wavelength_nm, 0.0).entrance_pupil_z_mm)
-}
-
 fn run_estimate(a: &EstimateArgs) -> Result<()> {
-    // A prescription's wavefront depends on where the fitted eye's entrance pupil lies: start
-    // from the estimator's own start eye and fit again while the fitted eye's pupil moved.
-    let wavelength_nm = a.wavelength_nm.unwrap_or(REFRACTION_WAVELENGTH_NM);
-    let mut pupil_depth_mm =
-        if a.rx.is_some() && crate::limits::WAVELENGTH_NM.contains(wavelength_nm) {
-            entrance_pupil_mm(&estimate::params::prior_centre(), wavelength_nm)?
-        } else {
-            0.0
-        };
-    let (mut target, command) = target(a, pupil_depth_mm)?;
+    let (target, command) = target(a)?;
     let mut outputs = Outputs::new();
     outputs.add("-o", &a.output, &["toml"])?;
     if let Some(p) = &a.json {
@@ -350,24 +323,11 @@ fn run_estimate(a: &EstimateArgs) -> Result<()> {
             ));
         }
     };
-    let mut fits = 0;
-    let est = loop {
-        let result = estimate::estimate(&target, &settings, &cancel, &mut progress);
-        let est = result.map_err(|e| match e {
-            estimate::EstimateError::Input(m) => Error::Input(m),
-            estimate::EstimateError::Eye(e) => Error::Eye(e),
-        })?;
-        fits += 1;
-        if a.rx.is_none() || fits == RX_FITS || cancel.load(Ordering::SeqCst) {
-            break est;
-        }
-        let fitted_mm = entrance_pupil_mm(&est.eye, target.wavelength_nm)?;
-        if (fitted_mm - pupil_depth_mm).abs() < RX_PUPIL_TOLERANCE_MM {
-            break est;
-        }
-        pupil_depth_mm = fitted_mm;
-        target = self::target(a, pupil_depth_mm)?.0;
-    };
+    let est = match &target {
+        Target::Wavefront(set) => estimate::estimate(set, &settings, &cancel, &mut progress),
+        Target::Prescription(rx) => rx.estimate(&settings, &cancel, &mut progress),
+    }
+    .map_err(estimate_error)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }

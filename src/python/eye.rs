@@ -50,16 +50,28 @@ fn check_field(field_deg: Option<(f64, f64)>) -> Result<Option<[f64; 2]>> {
     Ok(Some([h, v]))
 }
 
-fn fit(target: &ZernikeSet, max_time_s: Option<f64>) -> Result<estimate::Estimate> {
-    let settings = Settings {
-        max_time_s,
-        ..Settings::default()
-    };
-    estimate::estimate(target, &settings, &AtomicBool::new(false), &mut |_| {}).map_err(|e| match e
-    {
+fn estimate_error(e: EstimateError) -> Error {
+    match e {
         EstimateError::Input(m) => Error::Input(m),
         EstimateError::Eye(e) => Error::Eye(e),
-    })
+    }
+}
+
+fn settings(max_time_s: Option<f64>) -> Settings {
+    Settings {
+        max_time_s,
+        ..Settings::default()
+    }
+}
+
+fn fit(target: &ZernikeSet, max_time_s: Option<f64>) -> Result<estimate::Estimate> {
+    estimate::estimate(
+        target,
+        &settings(max_time_s),
+        &AtomicBool::new(false),
+        &mut |_| {},
+    )
+    .map_err(estimate_error)
 }
 
 impl PyEye {
@@ -157,22 +169,36 @@ impl PyEye {
         })
     }
 
-    /// A physical eye fitted to a spectacle prescription "S C x A" over `pupil_mm`.
+    /// A physical eye fitted to a spectacle prescription "S C x A" at `vertex_mm` in front of
+    /// the cornea, over a `pupil_mm` entrance pupil, as `ocular eye estimate --rx` fits it
+    /// (`wavelength_nm` None: 549 nm).
     #[staticmethod]
-    #[pyo3(signature = (rx, pupil_mm = 4.0, wavelength_nm = 555.0, max_time_s = None))]
+    #[pyo3(signature = (rx, pupil_mm = 4.0, wavelength_nm = None, vertex_mm = 12.0, max_time_s = None))]
     fn from_rx(
         py: Python<'_>,
         rx: &str,
         pupil_mm: f64,
-        wavelength_nm: f64,
+        wavelength_nm: Option<f64>,
+        vertex_mm: f64,
         max_time_s: Option<f64>,
     ) -> PyResult<PyEye> {
         check_pupil("--pupil-mm", pupil_mm).map_err(super::to_py)?;
-        let target = estimate::prescription_target(rx, pupil_mm, wavelength_nm)
-            .map_err(|e| value_error(format!("--rx: {e}")))?;
-        let source =
-            format!("Eye.from_rx({rx:?}, pupil_mm={pupil_mm}, wavelength_nm={wavelength_nm})");
-        PyEye::estimated(py, target, max_time_s, source)
+        let target = estimate::RxTarget::new(rx, pupil_mm, wavelength_nm, Some(vertex_mm))
+            .map_err(|e| super::to_py(estimate_error(e)))?;
+        let source = format!(
+            "Eye.from_rx({rx:?}, pupil_mm={pupil_mm}, wavelength_nm={}, vertex_mm={})",
+            target.wavelength_nm, target.vertex_mm
+        );
+        let est = guarded(py, move || {
+            target
+                .estimate(&settings(max_time_s), &AtomicBool::new(false), &mut |_| {})
+                .map_err(estimate_error)
+        })?;
+        Ok(PyEye {
+            eye: est.eye,
+            estimate: Some(est.report),
+            source,
+        })
     }
 
     /// A physical eye fitted to a wavefront: OSA/ANSI-ordered Zernike coefficients (µm,

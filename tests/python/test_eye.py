@@ -26,21 +26,34 @@ def test_unknown_preset_is_a_value_error_naming_the_presets():
         oc.Eye.preset("nope")
 
 
+def pupil_power_vector(sphere_d, cylinder_d, axis_deg, distance_mm):
+    """A spectacle's principal meridians F carried distance_mm to the eye's pupil: F / (1 - dF)."""
+    d = distance_mm * 1e-3
+    k1 = sphere_d / (1 - d * sphere_d)
+    k2 = (sphere_d + cylinder_d) / (1 - d * (sphere_d + cylinder_d))
+    return power_vector(k1, k2 - k1, axis_deg)
+
+
 def test_eye_from_rx_measures_back_its_prescription():
-    rx = (-2.25, -1.50, 35.0)
-    eye = oc.Eye.from_rx("-2.25 -1.50 x 35", pupil_mm=4.0)
+    rx, text = (-2.25, -1.50, 35.0), "-2.25 -1.50 x 35"
+    eye = oc.Eye.from_rx(text, pupil_mm=4.0)
     assert eye.converged
-    r = eye.refraction(pupil_mm=4.0, wavelength_nm=555.0)
-    m, j0, j45 = power_vector(*rx)
-    # Traced through the fitted eye, the minimum-RMS refraction is the prescription's.
+    # A spectacle 12 mm in front of the cornea, as `eye estimate --rx` reads it: at the
+    # entrance pupil (about 3 mm behind the cornea; a millimetre moves this one by 0.01 D) and
+    # the fitting wavelength, the traced refraction is the lens carried 15 mm.
+    r = eye.refraction(pupil_mm=4.0, wavelength_nm=549.0)
+    m, j0, j45 = pupil_power_vector(*rx, 12.0 + 3.0)
     assert r.m == pytest.approx(m, abs=0.03)
     assert r.j0 == pytest.approx(j0, abs=0.03)
     assert r.j45 == pytest.approx(j45, abs=0.03)
-    assert r.sphere_d == pytest.approx(rx[0], abs=0.05)
-    assert r.cylinder_d == pytest.approx(rx[1], abs=0.05)
-    assert r.axis_deg == pytest.approx(rx[2], abs=1.0)
-    # Negative control: another prescription's eye does not pass the same bar.
-    other = oc.Eye.from_rx("-1.25 -1.50 x 80", pupil_mm=4.0).refraction(4.0, 555.0)
+    # Seen through the same lens at 12 mm, the eye is emmetropic.
+    c = eye.with_correction(text).refraction(pupil_mm=4.0, wavelength_nm=549.0)
+    assert max(abs(c.m), abs(c.j0), abs(c.j45)) < 0.12
+    # Negative controls: the lens taken at the cornea (vertex_mm=0) misses the pupil bar
+    # (by about 0.11 D), and another prescription's eye misses it by far more.
+    cornea = oc.Eye.from_rx(text, pupil_mm=4.0, vertex_mm=0.0).refraction(4.0, 549.0)
+    assert abs(cornea.m - m) > 2 * 0.03
+    other = oc.Eye.from_rx("-1.25 -1.50 x 80", pupil_mm=4.0).refraction(4.0, 549.0)
     assert abs(other.m - m) > 0.5 and abs(other.j0 - j0) > 0.5
 
 

@@ -17,6 +17,7 @@ pub mod least_squares;
 pub mod loss;
 pub mod params;
 pub mod pattern_search;
+pub mod prescription;
 
 use crate::aberrations::ZernikeSet;
 use crate::eye::model::{Eye, EyeError};
@@ -28,6 +29,8 @@ use pattern_search::{pattern_search, GpsSettings, Limits, Outcome, Stop};
 use serde::Serialize;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
+
+pub use prescription::RxTarget;
 
 /// The hybrid's polish ends when this many pattern-search iterations together gain less
 /// than this fraction of the loss. Where the input is not exactly reachable (keratoconus:
@@ -199,23 +202,6 @@ pub fn check_target(target: &ZernikeSet) -> Result<(), EstimateError> {
         }
     }
     Ok(())
-}
-
-/// The wavefront a spectacle prescription "S C x A" stands for over a `pupil_mm` pupil at
-/// `wavelength_nm`: its second-order terms (what `eye estimate --rx` and the Python module
-/// fit an eye to). The error is the prescription parser's, for the caller to prefix.
-pub fn prescription_target(
-    rx: &str,
-    pupil_mm: f64,
-    wavelength_nm: f64,
-) -> Result<ZernikeSet, crate::optics::zernike::PrescriptionError> {
-    let p = crate::optics::zernike::Prescription::parse(rx)?;
-    let [cm, c0, cp] = p.to_zernike(pupil_mm);
-    Ok(ZernikeSet {
-        pupil_diameter_mm: pupil_mm,
-        wavelength_nm,
-        coefficients: vec![(2, -2, cm), (2, 0, c0), (2, 2, cp)],
-    })
 }
 
 /// Fits an eye to `target`. `cancel` (set from a signal handler, say) and the time limit stop

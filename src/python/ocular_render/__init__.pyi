@@ -43,10 +43,12 @@ class Eye:
     def from_rx(
         rx: str,
         pupil_mm: float = 4.0,
-        wavelength_nm: float = 555.0,
+        wavelength_nm: Optional[float] = None,
+        vertex_mm: float = 12.0,
         max_time_s: Optional[float] = None,
     ) -> Eye:
-        """Fits an eye to a spectacle prescription "S C x A" over a pupil (mm, 1 to 9)."""
+        """Fits an eye to a spectacle prescription "S C x A" at vertex_mm (0 to 16) over a
+        pupil (mm, 1 to 9), as `ocular eye estimate --rx` does; wavelength_nm None: 549 nm."""
     @staticmethod
     def from_zernike(
         coefficients_um: Union[Sequence[float], _F64],
