@@ -273,13 +273,10 @@ fn blurred_point_over_sharp_background_renders_as_its_kernel() {
                 let (dx, dy) = (x - px as i64, y - py as i64);
                 let w = weight_at(r0, dx, dy) * (1.0 - tr) + weight_at(r1, dx, dy) * tr;
                 // The point's group covers w of each pixel and the black in-focus background
-                // the rest, so the pixels show its kernel; at its own pixel nothing lies
-                // behind the point (single-layer input), so C / A returns its colour.
-                let want = if (dx, dy) == (0, 0) {
-                    white[c]
-                } else {
-                    w * white[c]
-                };
+                // the rest, so the pixels show its kernel; at its own pixel, where the single
+                // layer holds nothing behind the point, the background around it fills the
+                // rest (before, C / A returned the point's colour there: it gained light).
+                let want = w * white[c];
                 let got = out.color[(y * 80 + x) as usize][c];
                 peak = peak.max(w * white_c);
                 worst = worst.max((got - want).abs());
