@@ -91,6 +91,22 @@ fn render(
     }
 }
 
+/// A one-layer colour + depth frame of `w`×`h` at a vertical field of `fov` degrees.
+fn one_layer<'a>(
+    (w, h, fov): (usize, usize, f64),
+    color: &'a [[f32; 4]],
+    depth: &'a [f32],
+) -> FrameInput<'a> {
+    FrameInput {
+        width: w as u32,
+        height: h as u32,
+        color,
+        depth_m: depth,
+        fov_y_deg: fov,
+        hidden_layers: &[],
+    }
+}
+
 fn db(a: &[[f32; 4]], b: &[[f32; 4]], w: usize, h: usize) -> f64 {
     psnr(ImageView::new(w, h, a), ImageView::new(w, h, b), 1.0)
 }
@@ -172,14 +188,7 @@ fn case1_small_blur_is_continuous_across_the_field() {
     let ctx = common::gpu();
     let (w, h, fov) = C1;
     let (color, depth) = case1_scene();
-    let input = FrameInput {
-        width: w as u32,
-        height: h as u32,
-        color: &color,
-        depth_m: &depth,
-        fov_y_deg: fov,
-        hidden_layers: &[],
-    };
+    let input = one_layer((w, h, fov), &color, &depth);
     let state = EyeState {
         focus_d: 1.0 / 6.0,
         pupil_mm: 5.0,
@@ -248,14 +257,7 @@ fn case2_a_point_before_a_distant_background_keeps_its_energy() {
     for distance_m in [0.25, 0.5] {
         for background in [1000.0f32, distance_m as f32] {
             let (color, depth, _) = point_scene(distance_m, background);
-            let input = FrameInput {
-                width: w as u32,
-                height: h as u32,
-                color: &color,
-                depth_m: &depth,
-                fov_y_deg: fov,
-                hidden_layers: &[],
-            };
+            let input = one_layer((w, h, fov), &color, &depth);
             // The background at the point's own depth is the cell where the method works: splat
             // only, as a check of the scene itself.
             let far = background > 10.0;
@@ -325,14 +327,7 @@ fn case4_spots_grow_with_the_pinhole_scale_to_the_frame_edge() {
         color[cy * w + x] = [1.0; 4];
         depth[cy * w + x] = axial(0.25, x, cy, w, h, fov);
     }
-    let input = FrameInput {
-        width: w as u32,
-        height: h as u32,
-        color: &color,
-        depth_m: &depth,
-        fov_y_deg: fov,
-        hidden_layers: &[],
-    };
+    let input = one_layer((w, h, fov), &color, &depth);
     let state = EyeState {
         focus_d: 0.0,
         pupil_mm: 6.0,
@@ -350,31 +345,7 @@ fn case4_spots_grow_with_the_pinhole_scale_to_the_frame_edge() {
         ..SplatSettings::default()
     };
     let control = render(&ctx, "healthy", &input, state, paper, false).splat;
-    let widths = |image: &[[f32; 4]], x: usize| {
-        let window = 36i64;
-        let (mut e, mut mx, mut my) = (0.0f64, 0.0, 0.0);
-        let mut samples = Vec::new();
-        for dy in -window..=window {
-            for dx in -window..=window {
-                let (px, py) = (x as i64 + dx, cy as i64 + dy);
-                if px < 0 || px >= w as i64 {
-                    continue;
-                }
-                let v = f64::from(image[py as usize * w + px as usize][1]);
-                samples.push((dx as f64, dy as f64, v));
-                e += v;
-                mx += v * dx as f64;
-                my += v * dy as f64;
-            }
-        }
-        let (mx, my) = (mx / e, my / e);
-        let (mut vx, mut vy) = (0.0, 0.0);
-        for (dx, dy, v) in samples {
-            vx += v * (dx - mx).powi(2);
-            vy += v * (dy - my).powi(2);
-        }
-        ((vx / e).sqrt(), (vy / e).sqrt())
-    };
+    let widths = |image: &[[f32; 4]], x: usize| common::spots::rms_widths(image, w, (x, cy), 36);
     for (name, image) in [
         ("splat", &out.splat),
         ("reference", out.reference.as_ref().unwrap()),
@@ -516,14 +487,7 @@ fn case3_an_in_focus_wall_past_a_near_edge() {
         }
         -10.0 * (se / n as f64).log10()
     };
-    let one = FrameInput {
-        width: w as u32,
-        height: h as u32,
-        color: &color0,
-        depth_m: &depth0,
-        fov_y_deg: fov,
-        hidden_layers: &[],
-    };
+    let one = one_layer((w, h, fov), &color0, &depth0);
     let two = FrameInput {
         hidden_layers: &hidden,
         ..one

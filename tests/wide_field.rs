@@ -154,31 +154,7 @@ fn equal_angular_blur_grows_with_the_pinhole_scale() {
         max_radius: 18,
     };
     // RMS width (px) of the green spot around column x, horizontally and vertically.
-    let widths = |image: &[[f32; 4]], x: usize| {
-        let (mut e, mut mx, mut my) = (0.0f64, 0.0, 0.0);
-        let window = 45i64;
-        let mut samples = Vec::new();
-        for dy in -window..=window {
-            for dx in -window..=window {
-                let (px, py) = (x as i64 + dx, cy as i64 + dy);
-                if px < 0 || px >= w as i64 {
-                    continue;
-                }
-                let v = f64::from(image[py as usize * w + px as usize][1]);
-                samples.push((dx as f64, dy as f64, v));
-                e += v;
-                mx += v * dx as f64;
-                my += v * dy as f64;
-            }
-        }
-        let (mx, my) = (mx / e, my / e);
-        let (mut vx, mut vy) = (0.0, 0.0);
-        for (dx, dy, v) in samples {
-            vx += v * (dx - mx).powi(2);
-            vy += v * (dy - my).powi(2);
-        }
-        ((vx / e).sqrt(), (vy / e).sqrt())
-    };
+    let widths = |image: &[[f32; 4]], x: usize| common::spots::rms_widths(image, w, (x, cy), 45);
     let ctx = common::gpu();
     let mut control_worst = 0.0f64;
     let mut worst = 0.0f64;

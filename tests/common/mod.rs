@@ -33,4 +33,5 @@ pub fn finish(ctx: Context) {
 
 pub mod blender;
 pub mod splat_cpu;
+pub mod spots;
 pub mod synthetic;
