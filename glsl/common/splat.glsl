@@ -217,13 +217,16 @@ ivec4 fragment_pixels(Fragment f) {
 }
 
 // Inclusive tile rectangle of `fragment_pixels`. Exact for the square kernel support.
-ivec4 fragment_tiles(Fragment f) {
-    ivec4 p = fragment_pixels(f);
+ivec4 tiles_of_pixels(ivec4 p) {
     if (p.x > p.z) {
         return p;
     }
     int t = int(frame.tile_size);
     return ivec4(p.xy / t, p.zw / t);
+}
+
+ivec4 fragment_tiles(Fragment f) {
+    return tiles_of_pixels(fragment_pixels(f));
 }
 
 #endif

@@ -32,7 +32,7 @@ void main() {
                 atomicAdd(evaluations_in_group,
                           uint(pixels.z - pixels.x + 1) * uint(pixels.w - pixels.y + 1));
             }
-            ivec4 tiles = fragment_tiles(f);
+            ivec4 tiles = tiles_of_pixels(pixels);  // the reach once per fragment
             for (int ty = tiles.y; ty <= tiles.w; ty++) {
                 for (int tx = tiles.x; tx <= tiles.z; tx++) {
                     atomicAdd(counts[uint(ty) * frame.tiles_x + uint(tx)], 1u);
