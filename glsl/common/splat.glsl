@@ -142,6 +142,13 @@ uint block_size(Fragment f) {
     return f.size & 0x7Fu;
 }
 
+// The inner ring's mean over the eight directions of a hidden fragment's ray mask (`size`):
+// what the pixel under its centre receives. Per fragment, not per pixel.
+float pupil_inner(uint size) {
+    // bits 3·i, i = 0 … 7: ring 0 of every direction
+    return float(bitCount((size >> 8u) & 0x249249u)) * 0.125;
+}
+
 // Per channel, the share of a fragment's light at pixel offset d that reaches the pupil. A
 // hidden-layer fragment's light through the pupil point at ρ·a in direction e lands near
 // ρ·r·e from its centre (r: that channel's blur radius; the fragments pass oriented the rays
@@ -153,30 +160,22 @@ uint block_size(Fragment f) {
 // no direction is defined there; between ½ and 1½ px of blur the two mix, so the share is
 // continuous in the radius. (Before, one radius for all channels made an in-focus green
 // channel depend on the single ray of direction 0 when red or blue were blurred.)
-vec3 pupil_share(Fragment f, vec2 d) {
-    uint rays = f.size >> 8u;
-    if ((f.size & HIDDEN_FRAGMENT) == 0u || rays == ALL_RAYS) {
+vec3 pupil_share(uint size, vec3 radius, float inner, vec2 d) {
+    uint rays = size >> 8u;
+    if ((size & HIDDEN_FRAGMENT) == 0u || rays == ALL_RAYS) {
         return vec3(1.0);
     }
     if (rays == 0u) {
         return vec3(0.0);
     }
     float dd = dot(d, d);
-    float inner = 0.0;
-    for (uint i = 0u; i < 8u; i++) {
-        inner += float((rays >> (3u * i)) & 1u);
-    }
-    inner *= 0.125;
     uint direction = uint(int(round(atan(d.y, d.x) * (4.0 / 3.14159265358979))) & 7);
-    vec3 share;
-    for (int c = 0; c < 3; c++) {
-        float r = max(f.radius[c], 1e-3);
-        uint ring = min(uint(3.0 * dd / (r * r)), 2u);
-        float ray = float((rays >> (3u * direction + ring)) & 1u);
-        float seen = dd < 0.25 ? inner : ray;
-        share[c] = mix(1.0, seen, clamp(r - 0.5, 0.0, 1.0));
-    }
-    return share;
+    // Written out per channel: a loop would count against lavapipe's loop-iteration cap.
+    vec3 r = max(radius, vec3(1e-3));
+    uvec3 ring = min(uvec3(3.0 * dd / (r * r)), uvec3(2u));
+    uvec3 ray = (uvec3(rays) >> (uvec3(3u * direction) + ring)) & 1u;
+    vec3 seen = dd < 0.25 ? vec3(inner) : vec3(ray);
+    return mix(vec3(1.0), seen, clamp(r - 0.5, vec3(0.0), vec3(1.0)));
 }
 
 // How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.

@@ -353,14 +353,17 @@ fn version_string(v: u32) -> String {
 
 fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice) -> DeviceInfo {
     // SAFETY: `physical` comes from this instance's enumeration.
-    let (props, driver, memory, families, max_allocation) = unsafe {
+    let (props, driver, memory, families, max_allocation, subgroup) = unsafe {
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
         let mut maintenance3 = vk::PhysicalDeviceMaintenance3Properties::default();
+        let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut props2 = vk::PhysicalDeviceProperties2::default()
             .push_next(&mut driver)
-            .push_next(&mut maintenance3);
+            .push_next(&mut maintenance3)
+            .push_next(&mut subgroup);
         instance.get_physical_device_properties2(physical, &mut props2);
         let props = props2.properties;
+        let subgroup = (subgroup.supported_stages, subgroup.supported_operations);
         let max_allocation = maintenance3.max_memory_allocation_size;
         let driver_name = driver
             .driver_info_as_c_str()
@@ -376,7 +379,14 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
             .unwrap_or_default();
         let memory = instance.get_physical_device_memory_properties(physical);
         let families = instance.get_physical_device_queue_family_properties(physical);
-        (props, driver_name, memory, families, max_allocation)
+        (
+            props,
+            driver_name,
+            memory,
+            families,
+            max_allocation,
+            subgroup,
+        )
     };
     let name = props
         .device_name_as_c_str()
@@ -394,6 +404,11 @@ fn describe(instance: &ash::Instance, index: usize, physical: vk::PhysicalDevice
         ))
     } else if pick_queue_family(&families).is_none() {
         Some("no queue family supports graphics and compute".into())
+    } else if !subgroup.0.contains(vk::ShaderStageFlags::COMPUTE)
+        || !subgroup.1.contains(vk::SubgroupFeatureFlags::ARITHMETIC)
+    {
+        // The convolution ORs its rows' fragment masks across the subgroup.
+        Some("no subgroup arithmetic in compute shaders".into())
     } else {
         None
     };

@@ -5,6 +5,7 @@
 // every comparator touching the padding can be skipped. Lists up to 2048 entries sort in
 // shared memory; longer ones sort in place in global memory (slower, but nothing is dropped).
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #define BANDS_BINDING 3
 #include "band.glsl"
 
@@ -16,9 +17,11 @@ layout(std430, binding = 2) coherent buffer Entries { uvec2 entries[]; };
 
 const uint SHARED_CAPACITY = 2048u;
 // Up to this length a rank sort (each key counts the keys before it) needs one barrier
-// instead of the network's log² n: much cheaper on CPU implementations, and keys are unique
-// (the fragment index breaks ties), so ranks are a permutation.
-const uint RANK_SORT_LIMIT = 512u;
+// instead of the network's log² n: much cheaper on CPU implementations (lavapipe: 1024 entries
+// rank-sorted four keys a thread cost less than the network), and keys are unique (the
+// fragment index breaks ties), so ranks are a permutation.
+const uint RANK_KEYS = 4u;
+const uint RANK_SORT_LIMIT = 256u * RANK_KEYS;
 shared uvec2 keys[SHARED_CAPACITY];
 
 void main() {
@@ -38,13 +41,27 @@ void main() {
     if (n <= RANK_SORT_LIMIT) {
         for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
         barrier();
-        for (uint i = t; i < n; i += 256u) {
-            uvec2 key = keys[i];
-            uint rank = 0u;
-            for (uint j = 0u; j < n; j++) {
-                rank += key_less(keys[j], key) ? 1u : 0u;
+        // Thread t ranks keys 4t … 4t + 3 in one pass over the list: a CPU implementation
+        // runs a subgroup's loop only while one of its threads has keys, and one load per step
+        // serves four comparisons.
+        uvec2 mine[RANK_KEYS];
+        uint rank[RANK_KEYS];
+        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+            uint i = RANK_KEYS * t + k;
+            mine[k] = i < n ? keys[i] : uvec2(0u);
+            rank[k] = 0u;
+        }
+        uint steps = RANK_KEYS * t < n ? n : 0u;
+        for (uint j = 0u; j < steps; j++) {
+            uvec2 other = keys[j];
+            [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+                rank[k] += key_less(other, mine[k]) ? 1u : 0u;
             }
-            entries[base + rank] = key;
+        }
+        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+            if (RANK_KEYS * t + k < n) {
+                entries[base + rank[k]] = mine[k];
+            }
         }
         return;
     }
