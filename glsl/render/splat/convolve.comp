@@ -46,6 +46,8 @@ layout(constant_id = 0) const uint TILE = 8u;
 // Off axis (a field lattice of more than one node): a pipeline of its own, so that the on-axis
 // convolution carries none of the four-node code.
 layout(constant_id = 1) const uint OFF_AXIS = 0u;
+// The seed paper's per-fragment blend (1) or depth groups (0); frame.blend_mode says the same.
+layout(constant_id = 2) const uint PER_FRAGMENT_BLEND = 0u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // A batch of up to 64 list entries is prepared once in shared memory (one thread each), so
@@ -59,10 +61,12 @@ const uint PIXELS = PER_AXIS * PER_AXIS;
 // blend sees the same sums in either blend mode. CPU implementations such as lavapipe run both
 // sides of every branch and a loop's body at least once, so extra work is paid only as slots.
 const uint SLOTS = 96u;
+// Filtered reads per slot.
+const uint READS = 3u;
 shared vec4 slot_reach[SLOTS];     // centre.xy, reach, the texture layer coordinate
 shared vec4 slot_scale[SLOTS];     // radial unit vector, radial and tangential shrink ((1, 1): none)
 shared vec4 slot_color[SLOTS];     // linear RGB, vergence (D)
-shared vec4 slot_read[SLOTS * 3u]; // per read: its kernel's centre texel + ½, bound r + 1, red coefficient
+shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's centre texel + ½, bound r + 1, red coefficient
 shared vec4 slot_gb[SLOTS * 2u];   // green and blue coefficients of the three reads, then the
                                    // weight applied after the reads and the per-fragment blend's
                                    // block pixel count (1 otherwise)
@@ -127,8 +131,8 @@ ReadPlan plan_reads(Fragment f, float pre) {
     [[unroll]] for (int c = 0; c < 3; c++) {
         // Past the largest level the kernel is zero: no read there.
         float hi = t[c] > 0.0 && uint(lo[c]) + 1u < level_count() ? lo[c] + 1.0 : -1.0;
-        uint s = plan_new_levels(plan, 0u, lo[c], hi) + plan.counts[0] <= 3u ? 0u
-               : plan_new_levels(plan, 1u, lo[c], hi) + plan.counts[1] <= 3u ? 1u : 2u;
+        uint s = plan_new_levels(plan, 0u, lo[c], hi) + plan.counts[0] <= READS ? 0u
+               : plan_new_levels(plan, 1u, lo[c], hi) + plan.counts[1] <= READS ? 1u : 2u;
         plan_add(plan, s, lo[c], c, (1.0 - t[c]) * pre);
         if (hi >= 0.0) {
             plan_add(plan, s, hi, c, t[c] * pre);
@@ -145,14 +149,14 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     slot_scale[j] = scale;
     slot_color[j] = vec4(f.color, f.dioptre);
     slot_hidden[j] = uvec4(f.size, floatBitsToUint(f.radius));
-    vec3 coef[3];
-    [[unroll]] for (uint i = 0u; i < 3u; i++) {
+    vec3 coef[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
+    [[unroll]] for (uint i = 0u; i < READS; i++) {
         bool used = i < plan.counts[s];
         uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
         coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
         // An unused read stays harmless: its bound rejects every offset.
-        slot_read[3u * j + i] = vec4(vec2(level_centres[l].xy) + 0.5,
-                                     used ? float(level_block_radius(l) + 1u) : 0.0, coef[i].r);
+        slot_read[READS * j + i] = vec4(vec2(level_centres[l].xy) + 0.5,
+                                        used ? float(level_block_radius(l) + 1u) : 0.0, coef[i].r);
     }
     slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
@@ -160,24 +164,31 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
 
 // Read i of slot j at kernel offset d in the region whose origin is `node`.
 vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 extent) {
-    vec4 at = slot_read[3u * j + i];
-    vec3 value = textureLod(psf_texture, vec3((node + at.xy + d) / extent, layer), 0.0).rgb;
-    // Past the block's zero ring lie other blocks: nothing counts there.
-    return all(lessThan(abs(d), vec2(at.z))) ? vec3(at.w, gb_r.xy) * value : vec3(0.0);
+    vec4 at = slot_read[READS * j + i];
+    vec3 w = vec3(0.0);
+    // Past the block's zero ring lie other blocks: nothing counts there. An unused read's
+    // bound is 0. (A GPU skips the read here; a CPU implementation reads and discards.)
+    if (all(lessThan(abs(d), vec2(at.z)))) {
+        w = vec3(at.w, gb_r.xy)
+          * textureLod(psf_texture, vec3((node + at.xy + d) / extent, layer), 0.0).rgb;
+    }
+    return w;
 }
 
 vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2 extent) {
-    return one_read(j, 0u, gb0.xyz, d, node, layer, extent)
-         + one_read(j, 1u, vec3(gb0.zw, 0.0), d, node, layer, extent)
-         + one_read(j, 2u, gb1.xyz, d, node, layer, extent);
+    vec3 w = one_read(j, 0u, gb0.xyz, d, node, layer, extent)
+           + one_read(j, 1u, vec3(gb0.zw, 0.0), d, node, layer, extent);
+    if (READS > 2u) {
+        w += one_read(j, 2u, gb1.xyz, d, node, layer, extent);
+    }
+    return w;
 }
 
 // Per-channel kernel weight of slot j at screen offset d: the local scale's kernel offset, the
 // reads, off axis the four field nodes mixed bilinearly.
-vec3 slot_weight(uint j, vec2 d) {
+vec3 slot_weight(uint j, vec2 d, vec2 extent) {
     vec4 s = slot_scale[j];
     vec2 k = kernel_offset(s.xy, s.zw, d);
-    vec2 extent = vec2(textureSize(psf_texture, 0).xy);
     float layer = slot_reach[j].w;
     vec4 gb0 = slot_gb[2u * j];
     vec4 gb1 = slot_gb[2u * j + 1u];
@@ -188,13 +199,24 @@ vec3 slot_weight(uint j, vec2 d) {
         vec4 weights = slot_node_weights[j];
         vec4 n01 = slot_nodes[2u * j];
         vec4 n23 = slot_nodes[2u * j + 1u];
-        w = weights.x * slot_reads(j, gb0, gb1, k, n01.xy, layer, extent)
-          + weights.y * slot_reads(j, gb0, gb1, k, n01.zw, layer, extent)
-          + weights.z * slot_reads(j, gb0, gb1, k, n23.xy, layer, extent)
-          + weights.w * slot_reads(j, gb0, gb1, k, n23.zw, layer, extent);
+        w = vec3(0.0);
+        if (weights.x > 0.0) {
+            w += weights.x * slot_reads(j, gb0, gb1, k, n01.xy, layer, extent);
+        }
+        if (weights.y > 0.0) {
+            w += weights.y * slot_reads(j, gb0, gb1, k, n01.zw, layer, extent);
+        }
+        if (weights.z > 0.0) {
+            w += weights.z * slot_reads(j, gb0, gb1, k, n23.xy, layer, extent);
+        }
+        if (weights.w > 0.0) {
+            w += weights.w * slot_reads(j, gb0, gb1, k, n23.zw, layer, extent);
+        }
     }
     // A merged block under the per-fragment blend: its s² pixels' coverage compounds.
-    w = gb1.w > 1.0 ? vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(gb1.w)) : w;
+    if (PER_FRAGMENT_BLEND != 0u) {
+        w = gb1.w > 1.0 ? vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(gb1.w)) : w;
+    }
     return w * gb1.z;
 }
 
@@ -300,7 +322,8 @@ void main() {
         Gg[q] = vec3(0.0);
         last[q] = -1.0;
     }
-    bool grouped = frame.blend_mode == 0u;
+    const bool grouped = PER_FRAGMENT_BLEND == 0u;
+    vec2 extent = vec2(textureSize(psf_texture, 0).xy);
 
     uint row = gl_LocalInvocationID.y;
     if (local_index < 8u) {
@@ -416,7 +439,7 @@ void main() {
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
                 if (abs(d.x) <= g.z && abs(d.y) <= g.z) {
-                    vec3 w = slot_weight(j, d);
+                    vec3 w = slot_weight(j, d, extent);
                     uvec4 hidden = slot_hidden[j];
                     vec3 share = pupil_share(hidden.x, uintBitsToFloat(hidden.yzw),
                                              pupil_inner(hidden.x), d);

@@ -18,10 +18,10 @@ layout(std430, binding = 2) coherent buffer Entries { uvec2 entries[]; };
 const uint SHARED_CAPACITY = 2048u;
 // Up to this length a rank sort (each key counts the keys before it) needs one barrier
 // instead of the network's log² n: much cheaper on CPU implementations (lavapipe: 1024 entries
-// rank-sorted four keys a thread cost less than the network), and keys are unique (the
+// rank-sorted eight keys a thread cost less than the network), and keys are unique (the
 // fragment index breaks ties), so ranks are a permutation.
-const uint RANK_KEYS = 4u;
-const uint RANK_SORT_LIMIT = 256u * RANK_KEYS;
+const uint RANK_KEYS = 8u;
+const uint RANK_SORT_LIMIT = 1024u;
 shared uvec2 keys[SHARED_CAPACITY];
 
 void main() {
@@ -41,9 +41,9 @@ void main() {
     if (n <= RANK_SORT_LIMIT) {
         for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
         barrier();
-        // Thread t ranks keys 4t … 4t + 3 in one pass over the list: a CPU implementation
+        // Thread t ranks keys 8t … 8t + 7 in one pass over the list: a CPU implementation
         // runs a subgroup's loop only while one of its threads has keys, and one load per step
-        // serves four comparisons.
+        // serves eight comparisons.
         uvec2 mine[RANK_KEYS];
         uint rank[RANK_KEYS];
         [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {

@@ -128,7 +128,12 @@ impl Splatter {
             tile_fill: tile_fill::TileFillPass::new(ctx)?,
             tile_sort: tile_sort::TileSortPass::new(ctx)?,
             band_plan: band_plan::BandPlanPass::new(ctx)?,
-            convolve: convolve::ConvolvePass::new(ctx, settings.tile_size, off_axis)?,
+            convolve: convolve::ConvolvePass::new(
+                ctx,
+                settings.tile_size,
+                off_axis,
+                settings.blend.mode == crate::render::blend::BlendMode::PerFragment,
+            )?,
             grid,
         })
     }

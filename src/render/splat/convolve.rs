@@ -14,8 +14,15 @@ pub(super) struct ConvolvePass {
 }
 
 impl ConvolvePass {
-    /// `off_axis`: the four-node kernels of a field lattice (src/render/splat/field.rs).
-    pub fn new(ctx: &Context, tile_size: u32, off_axis: bool) -> GpuResult<Self> {
+    /// `off_axis`: the four-node kernels of a field lattice (src/render/splat/field.rs);
+    /// `per_fragment`: the seed paper's blend instead of depth groups. Both are pipeline
+    /// constants, so the convolution carries no code for the other case.
+    pub fn new(
+        ctx: &Context,
+        tile_size: u32,
+        off_axis: bool,
+        per_fragment: bool,
+    ) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
                 .bindings(&kinds_with_fragments(
@@ -34,6 +41,7 @@ impl ConvolvePass {
                 .push_constants::<BandPush>()
                 .specialize(0, tile_size)
                 .specialize(1, u32::from(off_axis))
+                .specialize(2, u32::from(per_fragment))
                 .build(ctx)?;
         Ok(ConvolvePass { pipeline })
     }
