@@ -7,20 +7,17 @@
 // A += (1 − A)·min(Ag, 1); the output is C / A. A hidden-layer fragment's light counts only
 // where its rays pass the nearer surfaces to the pupil (close_group, pupil_share).
 // (blend_mode 1: the seed paper's per-fragment C += (1 − A)·w·c, A += (1 − A)·w.) The kernel
-// weight w comes from trilinear lookups in the PSF texture (each channel mixes the two radius
-// levels around its radius; the layer axis blends the two neighbouring object distances) at
-// the kernel offset of the local pinhole scale; off axis, the kernels of the four field nodes
+// weight w comes from two trilinear lookups in the PSF texture (floor and ceiling radius; the
+// layer axis blends the two neighbouring object distances), mixed by frac(radius), at the
+// kernel offset of the local pinhole scale; off axis, the kernels of the four field nodes
 // around the fragment, mixed bilinearly (glsl/common/field.glsl).
-// Cost: a subgroup visits only the batch's fragments that reach one of its rows, and a visit
-// is the reach test, three filtered reads (six for a fragment whose channels span more than
-// three radius levels) and the blend. CPU implementations run every side of every branch, so
-// the code avoids branches whose sides read the texture.
+// This walk is for GPUs, where a fragment's uniform branches skip what it does not need; CPU
+// implementations run convolve_visits.comp, which computes the same in another shape.
 #extension GL_GOOGLE_include_directive : require
 // Every constant-count loop is unrolled: lavapipe's shader compiler caps the iterations of all
 // loops of one invocation together at 65535 and silently stops the rest, leaving pixels
 // unwritten on long tile lists (off axis the four-node and per-pixel loops ran per fragment).
 #extension GL_EXT_control_flow_attributes : require
-#extension GL_KHR_shader_subgroup_arithmetic : require
 #define FRAME_BINDING 12
 #define BANDS_BINDING 7
 #define ATLAS_BINDING 8
@@ -46,178 +43,86 @@ layout(constant_id = 0) const uint TILE = 8u;
 // Off axis (a field lattice of more than one node): a pipeline of its own, so that the on-axis
 // convolution carries none of the four-node code.
 layout(constant_id = 1) const uint OFF_AXIS = 0u;
-// The seed paper's per-fragment blend (1) or depth groups (0); frame.blend_mode says the same.
-layout(constant_id = 2) const uint PER_FRAGMENT_BLEND = 0u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
-// A batch of up to 64 list entries is prepared once in shared memory (one thread each), so
-// that what a pixel does per visit is only the reach test, three filtered reads and the blend.
-// What a fragment needs from the PSF texture is decided then: each channel mixes the two
-// radius levels around its radius, and the reads are grouped by channel into slots of at most
-// three levels each, with per-channel coefficients (the radius mix, the block's (2r+1)² storage
-// scale, and in the grouped blend the local scale's weight and a merged block's pixel count).
-// The usual fragment is one slot; one whose channels span more levels takes two or three
-// consecutive slots, each carrying only its own channels' light (zero in the others), so the
-// blend sees the same sums in either blend mode. CPU implementations such as lavapipe run both
-// sides of every branch and a loop's body at least once, so extra work is paid only as slots.
-const uint SLOTS = 96u;
-// Filtered reads per slot.
-const uint READS = 3u;
-shared vec4 slot_reach[SLOTS];     // centre.xy, reach, the texture layer coordinate
-shared vec4 slot_scale[SLOTS];     // radial unit vector, radial and tangential shrink ((1, 1): none)
-shared vec4 slot_color[SLOTS];     // linear RGB, vergence (D)
-shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's centre texel + ½, bound r + 1, red coefficient
-shared vec4 slot_gb[SLOTS * 2u];   // green and blue coefficients of the three reads, then the
-                                   // weight applied after the reads and the per-fragment blend's
-                                   // block pixel count (1 otherwise)
-shared uvec4 slot_hidden[SLOTS];   // size bits, radius (float bits) per channel
-shared vec4 slot_nodes[SLOTS * 2u]; // off axis: the four field nodes' region origins
-shared vec4 slot_node_weights[SLOTS];
-shared uint entry_slots[64];       // slots per entry of the batch, then their running sum
-shared uvec3 row_slots[8];         // per thread row: the batch's slots that reach its pixels
-shared uint batch_taken;           // entries of this batch that fit in the slots
-shared uint unsaturated;           // threads with a pixel whose closed groups cover < 1 − ε
+// The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
+// reads 16 bytes instead of the whole 48-byte fragment.
+shared vec4 batch_reach[64];   // centre.xy, reach, 1 when the local scale applies
+shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shrink
+shared Fragment batch[64];
+shared uvec4 batch_nodes[64];  // off axis: the four field nodes around the fragment
+shared vec4 batch_node_weights[64];
+shared uint unsaturated;       // threads with a pixel whose closed groups cover < 1 − ε
 
-// A fragment's reads: per slot up to three radius levels and their per-channel coefficients.
-struct ReadPlan {
-    float levels[9];  // slot s, read i at 3s + i
-    vec3 coefs[9];
-    uint counts[3];
-    uint slots;
-};
-
-// Adds level l with coefficient a for channel c to slot s (or to its read of that level).
-void plan_add(inout ReadPlan plan, uint s, float l, int c, float a) {
-    uint r = level_block_radius(uint(l));
+// RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block) of
+// field node `node`, at offset d from the kernel's centre. Past the block's zero ring, and
+// past the largest level, the kernel is zero and the atlas holds other blocks or nothing:
+// nothing is read there.
+vec3 kernel_rgb(vec2 d, float l, float index, uint node) {
+    uint level = uint(l);
+    uint r = level_block_radius(level);
+    if (level >= level_count() || any(greaterThanEqual(abs(d), vec2(float(r + 1u))))) {
+        return vec3(0.0);
+    }
+    vec3 extent = vec3(textureSize(psf_texture, 0));
+    vec3 uvw = vec3((vec2(kernel_centre(node, level)) + 0.5 + d) / extent.xy,
+                    (index + 0.5) / extent.z);
     float k = float(2u * r + 1u);
-    bool found = false;
-    [[unroll]] for (uint i = 0u; i < 3u; i++) {
-        if (!found && i < plan.counts[s] && plan.levels[3u * s + i] == l) {
-            plan.coefs[3u * s + i][c] += a / (k * k);
-            found = true;
-        }
-    }
-    if (!found) {
-        uint i = 3u * s + plan.counts[s];
-        plan.levels[i] = l;
-        plan.coefs[i] = vec3(0.0);
-        plan.coefs[i][c] = a / (k * k);
-        plan.counts[s]++;
-    }
+    return textureLod(psf_texture, uvw, 0.0).rgb / (k * k);
 }
 
-// Levels of slot s not yet among its reads, of the pair (l0, l1) (l1 < 0: none).
-uint plan_new_levels(ReadPlan plan, uint s, float l0, float l1) {
-    bool has0 = false;
-    bool has1 = l1 < 0.0;
-    [[unroll]] for (uint i = 0u; i < 3u; i++) {
-        bool used = i < plan.counts[s];
-        has0 = has0 || (used && plan.levels[3u * s + i] == l0);
-        has1 = has1 || (used && plan.levels[3u * s + i] == l1);
-    }
-    return (has0 ? 0u : 1u) + (has1 ? 0u : 1u);
-}
-
-ReadPlan plan_reads(Fragment f, float pre) {
-    ReadPlan plan;
-    [[unroll]] for (uint i = 0u; i < 9u; i++) {
-        plan.levels[i] = 0.0;
-        plan.coefs[i] = vec3(0.0);
-    }
-    plan.counts = uint[3](0u, 0u, 0u);
+// Per-channel kernel of fragment f at offset d at field node `node`: each channel's radius
+// lies between two radius levels; when all channels' levels fall within three consecutive ones
+// (the usual case), the three lookups serve every channel, else each channel takes its own two.
+vec3 kernel_at(Fragment f, vec2 d, uint node) {
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
     vec3 t = level - lo;
-    [[unroll]] for (int c = 0; c < 3; c++) {
-        // Past the largest level the kernel is zero: no read there.
-        float hi = t[c] > 0.0 && uint(lo[c]) + 1u < level_count() ? lo[c] + 1.0 : -1.0;
-        uint s = plan_new_levels(plan, 0u, lo[c], hi) + plan.counts[0] <= READS ? 0u
-               : plan_new_levels(plan, 1u, lo[c], hi) + plan.counts[1] <= READS ? 1u : 2u;
-        plan_add(plan, s, lo[c], c, (1.0 - t[c]) * pre);
-        if (hi >= 0.0) {
-            plan_add(plan, s, hi, c, t[c] * pre);
+    float base = min(lo.r, min(lo.g, lo.b));
+    float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
+    vec3 w;
+    if (top - base <= 2.0) {
+        vec3 s0 = kernel_rgb(d, base, f.index, node);
+        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index, node) : s0;
+        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index, node) : s1;
+        // Component-wise selection (no dynamic indexing): channel c reads s[i0] and s[i0 + 1].
+        vec3 i0 = lo - base;
+        vec3 a = mix(mix(s0, s1, step(0.5, i0)), s2, step(1.5, i0));
+        vec3 b = mix(s1, s2, step(0.5, i0));
+        w = mix(a, b, t);
+    } else {
+        [[unroll]] for (int c = 0; c < 3; c++) {
+            float a = kernel_rgb(d, lo[c], f.index, node)[c];
+            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, node)[c], t[c]) : a;
         }
     }
-    plan.slots = plan.counts[2] > 0u ? 3u : plan.counts[1] > 0u ? 2u : 1u;
-    return plan;
-}
-
-// Fills slot j with slot s of fragment f's plan.
-void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale, float post,
-               float pixels) {
-    slot_reach[j] = reach;
-    slot_scale[j] = scale;
-    slot_color[j] = vec4(f.color, f.dioptre);
-    slot_hidden[j] = uvec4(f.size, floatBitsToUint(f.radius));
-    vec3 coef[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
-    [[unroll]] for (uint i = 0u; i < READS; i++) {
-        bool used = i < plan.counts[s];
-        uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
-        coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
-        // An unused read stays harmless: its bound rejects every offset.
-        slot_read[READS * j + i] = vec4(vec2(level_centres[l].xy) + 0.5,
-                                        used ? float(level_block_radius(l) + 1u) : 0.0, coef[i].r);
-    }
-    slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
-    slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
-}
-
-// Read i of slot j at kernel offset d in the region whose origin is `node`.
-vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 extent) {
-    vec4 at = slot_read[READS * j + i];
-    vec3 w = vec3(0.0);
-    // Past the block's zero ring lie other blocks: nothing counts there. An unused read's
-    // bound is 0. (A GPU skips the read here; a CPU implementation reads and discards.)
-    if (all(lessThan(abs(d), vec2(at.z)))) {
-        w = vec3(at.w, gb_r.xy)
-          * textureLod(psf_texture, vec3((node + at.xy + d) / extent, layer), 0.0).rgb;
-    }
     return w;
 }
 
-vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2 extent) {
-    vec3 w = one_read(j, 0u, gb0.xyz, d, node, layer, extent)
-           + one_read(j, 1u, vec3(gb0.zw, 0.0), d, node, layer, extent);
-    if (READS > 2u) {
-        w += one_read(j, 2u, gb1.xyz, d, node, layer, extent);
-    }
-    return w;
-}
-
-// Per-channel kernel weight of slot j at screen offset d: the local scale's kernel offset, the
-// reads, off axis the four field nodes mixed bilinearly.
-vec3 slot_weight(uint j, vec2 d, vec2 extent) {
-    vec4 s = slot_scale[j];
-    vec2 k = kernel_offset(s.xy, s.zw, d);
-    float layer = slot_reach[j].w;
-    vec4 gb0 = slot_gb[2u * j];
-    vec4 gb1 = slot_gb[2u * j + 1u];
+// Per-channel weight of batch fragment j at offset d: off axis, the four field nodes' kernels
+// at the fragment's radius, mixed bilinearly in field angle.
+vec3 fragment_weight(uint j, Fragment f, vec2 d) {
     vec3 w;
     if (OFF_AXIS == 0u) {
-        w = slot_reads(j, gb0, gb1, k, vec2(0.0), layer, extent);
+        w = kernel_at(f, d, 0u);
     } else {
-        vec4 weights = slot_node_weights[j];
-        vec4 n01 = slot_nodes[2u * j];
-        vec4 n23 = slot_nodes[2u * j + 1u];
         w = vec3(0.0);
-        if (weights.x > 0.0) {
-            w += weights.x * slot_reads(j, gb0, gb1, k, n01.xy, layer, extent);
-        }
-        if (weights.y > 0.0) {
-            w += weights.y * slot_reads(j, gb0, gb1, k, n01.zw, layer, extent);
-        }
-        if (weights.z > 0.0) {
-            w += weights.z * slot_reads(j, gb0, gb1, k, n23.xy, layer, extent);
-        }
-        if (weights.w > 0.0) {
-            w += weights.w * slot_reads(j, gb0, gb1, k, n23.zw, layer, extent);
+        uvec4 nodes = batch_nodes[j];
+        vec4 weights = batch_node_weights[j];
+        [[unroll]] for (uint k = 0u; k < 4u; k++) {
+            if (weights[k] > 0.0) {
+                w += weights[k] * kernel_at(f, d, nodes[k]);
+            }
         }
     }
-    // A merged block under the per-fragment blend: its s² pixels' coverage compounds.
-    if (PER_FRAGMENT_BLEND != 0u) {
-        w = gb1.w > 1.0 ? vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(gb1.w)) : w;
+    uint size = block_size(f);
+    if (size > 1u) {
+        // A merged block carries size² pixels' worth of the same light.
+        float n = float(size * size);
+        w = frame.blend_mode == 0u ? n * w
+                                   : vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(n));
     }
-    return w * gb1.z;
+    return w;
 }
 
 // Composites the open group behind what is already there and empties it. Its coverage is
@@ -322,139 +227,58 @@ void main() {
         Gg[q] = vec3(0.0);
         last[q] = -1.0;
     }
-    const bool grouped = PER_FRAGMENT_BLEND == 0u;
-    vec2 extent = vec2(textureSize(psf_texture, 0).xy);
+    bool grouped = frame.blend_mode == 0u;
 
-    uint row = gl_LocalInvocationID.y;
-    if (local_index < 8u) {
-        row_slots[local_index] = uvec3(0u);
-    }
-    barrier();
-    uint start = 0u;
-    while (start < n) {
-        // 1. Each thread plans one entry's reads and counts its slots.
-        bool loaded = start + local_index < n;
-        Fragment f;
-        ReadPlan plan;
-        vec4 reach;
-        vec4 scale;
-        float post = 1.0;
-        float pixels = 1.0;
-        uint slots = 0u;
-        if (loaded) {
-            f = load_fragment(entries[base + start + local_index].y);
-            vec3 s = local_scale(f.center);
-            // The largest channel radius decides how much of the local scale applies.
-            float rmax = max(f.radius.r, max(f.radius.g, f.radius.b));
-            vec2 c = shrink_for_radius(s.z, rmax);
-            bool scaled = c.x < 1.0;
-            float extent_z = float(textureSize(psf_texture, 0).z);
-            reach = vec4(f.center, fragment_reach(f), (f.index + 0.5) / extent_z);
-            scale = scaled ? vec4(s.xy, c) : vec4(1.0, 0.0, 1.0, 1.0);
-            uint size = block_size(f);
-            float n_px = float(size * size);
-            // Grouped, a merged block's light and the local scale's weight are linear factors
-            // of the reads; the per-fragment blend raises the summed weight to the block's
-            // pixel count first.
-            float local_weight = scaled ? c.x * c.y : 1.0;
-            float pre = grouped ? (size > 1u ? n_px : 1.0) * local_weight : 1.0;
-            post = grouped ? 1.0 : local_weight;
-            pixels = !grouped && size > 1u ? n_px : 1.0;
-            plan = plan_reads(f, pre);
-            slots = plan.slots;
-        }
-        entry_slots[local_index] = slots;
+    for (uint start = 0u; start < n; start += 64u) {
         if (local_index == 0u) {
             unsaturated = 0u;
-            batch_taken = 0u;
         }
-        barrier();
-        // 2. A running sum gives each entry its first slot, in list order.
-        [[unroll]] for (uint stride = 1u; stride < 64u; stride <<= 1u) {
-            uint add = local_index >= stride ? entry_slots[local_index - stride] : 0u;
-            barrier();
-            entry_slots[local_index] += add;
-            barrier();
-        }
-        uint first = entry_slots[local_index] - slots;
-        bool fits = loaded && first + slots <= SLOTS;
-        // 3. The entries that fit fill their slots and mark the thread rows they reach, by the
-        // very test the pixels make below.
-        if (fits) {
-            atomicAdd(batch_taken, 1u);
-            [[unroll]] for (uint k = 0u; k < 3u; k++) {
-                if (k < slots) {
-                    fill_slot(first + k, f, plan, k, reach, scale, post, pixels);
-                }
-            }
+        if (start + local_index < n) {
+            Fragment f = load_fragment(entries[base + start + local_index].y);
+            batch[local_index] = f;
             if (OFF_AXIS != 0u) {
                 uvec4 nodes;
                 vec4 weights;
                 field_corners(f.center, nodes, weights);
-                vec4 n01 = vec4(vec2(node_origin(nodes.x)), vec2(node_origin(nodes.y)));
-                vec4 n23 = vec4(vec2(node_origin(nodes.z)), vec2(node_origin(nodes.w)));
-                [[unroll]] for (uint k = 0u; k < 3u; k++) {
-                    if (k < slots) {
-                        slot_nodes[2u * (first + k)] = n01;
-                        slot_nodes[2u * (first + k) + 1u] = n23;
-                        slot_node_weights[first + k] = weights;
-                    }
-                }
+                batch_nodes[local_index] = nodes;
+                batch_node_weights[local_index] = weights;
             }
-            // Bits first … first + slots − 1 of the 96-bit row masks.
-            uvec3 index = uvec3(0u, 32u, 64u);
-            uvec3 lo = uvec3(clamp(ivec3(first) - ivec3(index), ivec3(0), ivec3(32)));
-            uvec3 hi = uvec3(clamp(ivec3(first + slots) - ivec3(index), ivec3(0), ivec3(32)));
-            uvec3 below_hi = mix(uvec3(0xFFFFFFFFu), (uvec3(1u) << hi) - 1u, lessThan(hi, uvec3(32u)));
-            uvec3 below_lo = mix(uvec3(0xFFFFFFFFu), (uvec3(1u) << lo) - 1u, lessThan(lo, uvec3(32u)));
-            uvec3 bits = below_hi & ~below_lo;
-            [[unroll]] for (uint y = 0u; y < 8u; y++) {
-                bool reached = false;
-                [[unroll]] for (uint k = 0u; k < PER_AXIS; k++) {
-                    float py = float(ty * TILE + y + 8u * k) + 0.5;
-                    reached = reached || abs(py - reach.y) <= reach.z;
-                }
-                if (reached) {
-                    atomicOr(row_slots[y].x, bits.x);
-                    atomicOr(row_slots[y].y, bits.y);
-                    atomicOr(row_slots[y].z, bits.z);
-                }
-            }
+            vec3 s = local_scale(f.center);
+            // The largest channel radius decides how much of the local scale applies.
+            float r = max(f.radius.r, max(f.radius.g, f.radius.b));
+            vec2 c = shrink_for_radius(s.z, r);
+            batch_reach[local_index] = vec4(f.center, fragment_reach(f), c.x < 1.0 ? 1.0 : 0.0);
+            batch_scale[local_index] = vec4(s.xy, c);
         }
         barrier();
-        // 4. The slots that reach any pixel of this subgroup, in list order: a loop uniform in
-        // the subgroup (lavapipe runs it until all its threads leave it).
-        uvec3 todo = subgroupOr(row_slots[row]);
-        while (any(notEqual(todo, uvec3(0u)))) {
-            bool in_x = todo.x != 0u;
-            bool in_y = !in_x && todo.y != 0u;
-            bool in_z = !in_x && !in_y;
-            uint j = in_x ? uint(findLSB(todo.x))
-                   : in_y ? 32u + uint(findLSB(todo.y)) : 64u + uint(findLSB(todo.z));
-            todo.x = in_x ? todo.x & (todo.x - 1u) : todo.x;
-            todo.y = in_y ? todo.y & (todo.y - 1u) : todo.y;
-            todo.z = in_z ? todo.z & (todo.z - 1u) : todo.z;
-            vec4 g = slot_reach[j];
-            vec4 color = slot_color[j];
+        uint batch_size = min(64u, n - start);
+        for (uint j = 0u; j < batch_size; j++) {
+            vec4 g = batch_reach[j];
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
-                if (abs(d.x) <= g.z && abs(d.y) <= g.z) {
-                    vec3 w = slot_weight(j, d, extent);
-                    uvec4 hidden = slot_hidden[j];
-                    vec3 share = pupil_share(hidden.x, uintBitsToFloat(hidden.yzw),
-                                             pupil_inner(hidden.x), d);
-                    if (grouped) {
-                        if (last[q] >= 0.0 && abs(color.w - last[q]) > frame.group_tolerance_d) {
-                            close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
-                        }
-                        Cg[q] += (w * share) * color.rgb;
-                        Ag[q] += w;
-                        Gg[q] += w * share;
-                        last[q] = color.w;
-                    } else {
-                        C[q] += (vec3(1.0) - A[q]) * (w * share) * color.rgb;
-                        A[q] += (vec3(1.0) - A[q]) * (w * share);
+                if (abs(d.x) > g.z || abs(d.y) > g.z) {
+                    continue;
+                }
+                Fragment f = batch[j];
+                vec3 w;
+                if (g.w > 0.5) {
+                    vec4 s = batch_scale[j];
+                    w = fragment_weight(j, f, kernel_offset(s.xy, s.zw, d)) * (s.z * s.w);
+                } else {
+                    w = fragment_weight(j, f, d);
+                }
+                vec3 g = pupil_share(f.size, f.radius, pupil_inner(f.size), d);
+                if (grouped) {
+                    if (last[q] >= 0.0 && abs(f.dioptre - last[q]) > frame.group_tolerance_d) {
+                        close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
                     }
+                    Cg[q] += (w * g) * f.color;
+                    Ag[q] += w;
+                    Gg[q] += w * g;
+                    last[q] = f.dioptre;
+                } else {
+                    C[q] += (vec3(1.0) - A[q]) * (w * g) * f.color;
+                    A[q] += (vec3(1.0) - A[q]) * (w * g);
                 }
             }
         }
@@ -470,10 +294,6 @@ void main() {
         }
         barrier();
         bool done = unsaturated == 0u;
-        start += batch_taken;
-        if (local_index < 8u) {
-            row_slots[local_index] = uvec3(0u);
-        }
         barrier();
         if (done) {
             break;

@@ -16,12 +16,14 @@ layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = 2) coherent buffer Entries { uvec2 entries[]; };
 
 const uint SHARED_CAPACITY = 2048u;
-// Up to this length a rank sort (each key counts the keys before it) needs one barrier
-// instead of the network's log² n: much cheaper on CPU implementations (lavapipe: 1024 entries
-// rank-sorted eight keys a thread cost less than the network), and keys are unique (the
-// fragment index breaks ties), so ranks are a permutation.
-const uint RANK_KEYS = 8u;
-const uint RANK_SORT_LIMIT = 1024u;
+// Up to RANK_SORT_LIMIT entries a rank sort (each key counts the keys before it) needs one
+// barrier instead of the network's log² n, and keys are unique (the fragment index breaks
+// ties), so ranks are a permutation. Each thread ranks RANK_KEYS consecutive keys in one pass
+// over the list: on a CPU implementation (lavapipe runs a subgroup's loop only while one of its
+// threads has keys, and one load serves every comparison of a step) 8 keys a thread and lists
+// up to 1024 sort faster than the network; on a GPU 2 keys and 512 (the network beyond).
+layout(constant_id = 0) const uint RANK_KEYS = 2u;
+const uint RANK_SORT_LIMIT = RANK_KEYS >= 4u ? 1024u : 256u * RANK_KEYS;
 shared uvec2 keys[SHARED_CAPACITY];
 
 void main() {
@@ -41,9 +43,6 @@ void main() {
     if (n <= RANK_SORT_LIMIT) {
         for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
         barrier();
-        // Thread t ranks keys 8t … 8t + 7 in one pass over the list: a CPU implementation
-        // runs a subgroup's loop only while one of its threads has keys, and one load per step
-        // serves eight comparisons.
         uvec2 mine[RANK_KEYS];
         uint rank[RANK_KEYS];
         [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {

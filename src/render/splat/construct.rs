@@ -133,6 +133,7 @@ impl Splatter {
                 settings.tile_size,
                 off_axis,
                 settings.blend.mode == crate::render::blend::BlendMode::PerFragment,
+                settings.convolve_walk.visits_on(ctx.device_info().kind),
             )?,
             grid,
         })

@@ -15,34 +15,44 @@ pub(super) struct ConvolvePass {
 
 impl ConvolvePass {
     /// `off_axis`: the four-node kernels of a field lattice (src/render/splat/field.rs);
-    /// `per_fragment`: the seed paper's blend instead of depth groups. Both are pipeline
-    /// constants, so the convolution carries no code for the other case.
+    /// `per_fragment`: the seed paper's blend instead of depth groups (a pipeline constant of
+    /// the visits walk; convolve.comp reads it from the frame block); `visit_slots`: the walk for
+    /// CPU implementations (glsl/render/splat/convolve_visits.comp says why).
     pub fn new(
         ctx: &Context,
         tile_size: u32,
         off_axis: bool,
         per_fragment: bool,
+        visit_slots: bool,
     ) -> GpuResult<Self> {
-        let pipeline =
+        let bindings = kinds_with_fragments(
+            &[BindingKind::SampledImage],
+            &[
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageImage,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+                BindingKind::StorageBuffer,
+            ],
+        );
+        let builder = if visit_slots {
+            ComputePipeline::builder(
+                "convolve",
+                crate::shaders::RENDER_SPLAT_CONVOLVE_VISITS_COMP,
+            )
+            .specialize(2, u32::from(per_fragment))
+        } else {
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
-                .bindings(&kinds_with_fragments(
-                    &[BindingKind::SampledImage],
-                    &[
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageImage,
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                    ],
-                ))
-                .uniform::<FrameUniform>()
-                .push_constants::<BandPush>()
-                .specialize(0, tile_size)
-                .specialize(1, u32::from(off_axis))
-                .specialize(2, u32::from(per_fragment))
-                .build(ctx)?;
+        };
+        let pipeline = builder
+            .bindings(&bindings)
+            .uniform::<FrameUniform>()
+            .push_constants::<BandPush>()
+            .specialize(0, tile_size)
+            .specialize(1, u32::from(off_axis))
+            .build(ctx)?;
         Ok(ConvolvePass { pipeline })
     }
 

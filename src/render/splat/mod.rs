@@ -38,7 +38,7 @@ use crate::psf::kernels::KernelGrid;
 use bands::{plan_bands, BandPush, PlannedBands};
 pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
-pub use settings::{MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
+pub use settings::{ConvolveWalk, MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
 use uniform::FrameBlock;
 pub(crate) use uniform::FrameUniform;
 pub use uniform::FRAME_UNIFORM_BYTES;

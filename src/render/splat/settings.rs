@@ -62,6 +62,32 @@ pub struct SplatSettings {
     /// past the nearer surfaces (false: wherever nearer depth groups leave coverage, as
     /// before; kept as the control `tests/layers.rs` measures against).
     pub pupil_visibility: bool,
+    /// How the convolution walks a tile's list (the same image either way).
+    pub convolve_walk: ConvolveWalk,
+}
+
+/// The convolution's two shapes (glsl/render/splat/convolve.comp and convolve_visits.comp):
+/// the same image, each fast on one kind of device.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ConvolveWalk {
+    /// Visits on a CPU implementation, pixels on a GPU.
+    #[default]
+    Auto,
+    /// Every pixel of a tile over every fragment, branching past what a fragment does not need.
+    Pixels,
+    /// Planned reads in shared memory, each visited by the subgroups whose rows it reaches.
+    Visits,
+}
+
+impl ConvolveWalk {
+    /// Whether the visits walk runs on a device of this kind.
+    pub fn visits_on(self, kind: crate::gpu::DeviceKind) -> bool {
+        match self {
+            ConvolveWalk::Auto => kind == crate::gpu::DeviceKind::Cpu,
+            ConvolveWalk::Pixels => false,
+            ConvolveWalk::Visits => true,
+        }
+    }
 }
 
 impl Default for SplatSettings {
@@ -76,6 +102,7 @@ impl Default for SplatSettings {
             saturation_epsilon: DEFAULT_SATURATION_EPSILON,
             steady_state: true,
             pupil_visibility: true,
+            convolve_walk: ConvolveWalk::Auto,
         }
     }
 }

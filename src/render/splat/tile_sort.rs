@@ -11,6 +11,7 @@ pub(super) struct TileSortPass {
 
 impl TileSortPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
+        let cpu = ctx.device_info().kind == crate::gpu::DeviceKind::Cpu;
         let pipeline =
             ComputePipeline::builder("tile sort", crate::shaders::RENDER_SPLAT_TILE_SORT_COMP)
                 .bindings(&[
@@ -20,6 +21,8 @@ impl TileSortPass {
                     BindingKind::StorageBuffer,
                 ])
                 .push_constants::<BandPush>()
+                // keys each thread ranks (glsl/render/splat/tile_sort.comp)
+                .specialize(0, if cpu { 8 } else { 2 })
                 .build(ctx)?;
         Ok(TileSortPass { pipeline })
     }

@@ -1,0 +1,499 @@
+#version 460
+// Convolution for CPU implementations (lavapipe): the same result as convolve.comp (which says
+// what the pass computes), walked in the shape a CPU runs fast. Such an implementation runs
+// both sides of every branch and a loop's body at least once, so convolve.comp's per-pixel
+// branches (both local-scale sides, both channel-span cases: up to eighteen texture reads per
+// (pixel, fragment) pair) all execute. Here each batch entry's reads are planned once in shared
+// memory and each subgroup loops only over the slots that reach its rows; a visit is the reach
+// test, three filtered reads and the blend. On a GPU this shape is slower (its shared memory
+// halves the occupancy; on an H200 the convolution took 1.6× convolve.comp's time), so the
+// pass picks the shader by the device's kind (src/render/splat/convolve.rs).
+#extension GL_GOOGLE_include_directive : require
+// Every constant-count loop is unrolled: lavapipe's shader compiler caps the iterations of all
+// loops of one invocation together at 65535 and silently stops the rest, leaving pixels
+// unwritten on long tile lists (off axis the four-node and per-pixel loops ran per fragment).
+#extension GL_EXT_control_flow_attributes : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#define FRAME_BINDING 12
+#define BANDS_BINDING 7
+#define ATLAS_BINDING 8
+#include "splat.glsl"
+#include "band.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(binding = 0) uniform sampler3D psf_texture;
+FRAGMENT_BUFFERS(1, 9, 10, 11, readonly)
+FRAGMENT_LOAD
+layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
+layout(std430, binding = 3) readonly buffer Offsets { uint offsets[]; };
+layout(std430, binding = 4) readonly buffer Entries { uvec2 entries[]; };
+layout(binding = 5, rgba32f) writeonly uniform image2D color_out;
+layout(std430, binding = 6) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
+#include "field.glsl"
+#include "atlas.glsl"
+
+// The tile side is fixed per pipeline, so the per-thread pixel arrays have a compile-time
+// size and live in registers (dynamic sizes cost CPU implementations such as lavapipe dearly).
+layout(constant_id = 0) const uint TILE = 8u;
+// Off axis (a field lattice of more than one node): a pipeline of its own, so that the on-axis
+// convolution carries none of the four-node code.
+layout(constant_id = 1) const uint OFF_AXIS = 0u;
+// The seed paper's per-fragment blend (1) or depth groups (0); frame.blend_mode says the same.
+layout(constant_id = 2) const uint PER_FRAGMENT_BLEND = 0u;
+const uint PER_AXIS = TILE / 8u;
+const uint PIXELS = PER_AXIS * PER_AXIS;
+const bool grouped = PER_FRAGMENT_BLEND == 0u;
+
+// Per pixel of this thread: its centre, the composited light and coverage, the open group's
+// light, coverage and weight of light that reaches the pupil, and the vergence of the last
+// fragment that reached it (−1: none).
+vec2 centre[PIXELS];
+vec3 C[PIXELS];
+vec3 A[PIXELS];
+vec3 Cg[PIXELS];
+vec3 Ag[PIXELS];
+vec3 Gg[PIXELS];
+float last[PIXELS];
+// A batch of up to 64 list entries is prepared once in shared memory (one thread each), so
+// that what a pixel does per visit is only the reach test, three filtered reads and the blend.
+// What a fragment needs from the PSF texture is decided then: each channel mixes the two
+// radius levels around its radius, and the reads are grouped by channel into slots of at most
+// three levels each, with per-channel coefficients (the radius mix, the block's (2r+1)² storage
+// scale, and in the grouped blend the local scale's weight and a merged block's pixel count).
+// The usual fragment is one slot; one whose channels span more levels takes two or three
+// consecutive slots, each carrying only its own channels' light (zero in the others), so the
+// blend sees the same sums in either blend mode. CPU implementations such as lavapipe run both
+// sides of every branch and a loop's body at least once, so extra work is paid only as slots.
+const uint SLOTS = 96u;
+// Filtered reads per slot.
+const uint READS = 3u;
+shared vec4 slot_reach[SLOTS];     // centre.xy, reach, the texture layer coordinate
+shared vec4 slot_scale[SLOTS];     // radial unit vector, radial and tangential shrink ((1, 1): none)
+shared vec4 slot_color[SLOTS];     // linear RGB, vergence (D)
+shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's centre texel + ½, bound r + 1, red coefficient
+shared vec4 slot_gb[SLOTS * 2u];   // green and blue coefficients of the three reads, then the
+                                   // weight applied after the reads and the per-fragment blend's
+                                   // block pixel count (1 otherwise)
+shared uvec4 slot_hidden[SLOTS];   // size bits, radius (float bits) per channel
+shared vec4 slot_nodes[SLOTS * 2u]; // off axis: the four field nodes' region origins
+shared vec4 slot_node_weights[SLOTS];
+shared uint entry_slots[64];       // slots per entry of the batch, then their running sum
+shared uvec3 row_slots[8];         // per thread row: the batch's slots that reach its pixels
+shared uint batch_taken;           // entries of this batch that fit in the slots
+shared uint unsaturated;           // threads with a pixel whose closed groups cover < 1 − ε
+
+// A fragment's reads: per slot up to three radius levels and their per-channel coefficients.
+struct ReadPlan {
+    float levels[9];  // slot s, read i at 3s + i
+    vec3 coefs[9];
+    uint counts[3];
+    uint slots;
+};
+
+// Adds level l with coefficient a for channel c to slot s (or to its read of that level).
+void plan_add(inout ReadPlan plan, uint s, float l, int c, float a) {
+    uint r = level_block_radius(uint(l));
+    float k = float(2u * r + 1u);
+    bool found = false;
+    [[unroll]] for (uint i = 0u; i < 3u; i++) {
+        if (!found && i < plan.counts[s] && plan.levels[3u * s + i] == l) {
+            plan.coefs[3u * s + i][c] += a / (k * k);
+            found = true;
+        }
+    }
+    if (!found) {
+        uint i = 3u * s + plan.counts[s];
+        plan.levels[i] = l;
+        plan.coefs[i] = vec3(0.0);
+        plan.coefs[i][c] = a / (k * k);
+        plan.counts[s]++;
+    }
+}
+
+// Levels of slot s not yet among its reads, of the pair (l0, l1) (l1 < 0: none).
+uint plan_new_levels(ReadPlan plan, uint s, float l0, float l1) {
+    bool has0 = false;
+    bool has1 = l1 < 0.0;
+    [[unroll]] for (uint i = 0u; i < 3u; i++) {
+        bool used = i < plan.counts[s];
+        has0 = has0 || (used && plan.levels[3u * s + i] == l0);
+        has1 = has1 || (used && plan.levels[3u * s + i] == l1);
+    }
+    return (has0 ? 0u : 1u) + (has1 ? 0u : 1u);
+}
+
+ReadPlan plan_reads(Fragment f, float pre) {
+    ReadPlan plan;
+    [[unroll]] for (uint i = 0u; i < 9u; i++) {
+        plan.levels[i] = 0.0;
+        plan.coefs[i] = vec3(0.0);
+    }
+    plan.counts = uint[3](0u, 0u, 0u);
+    vec3 level = level_of_radius(f.radius);
+    vec3 lo = floor(level);
+    vec3 t = level - lo;
+    [[unroll]] for (int c = 0; c < 3; c++) {
+        // Past the largest level the kernel is zero: no read there.
+        float hi = t[c] > 0.0 && uint(lo[c]) + 1u < level_count() ? lo[c] + 1.0 : -1.0;
+        uint s = plan_new_levels(plan, 0u, lo[c], hi) + plan.counts[0] <= READS ? 0u
+               : plan_new_levels(plan, 1u, lo[c], hi) + plan.counts[1] <= READS ? 1u : 2u;
+        plan_add(plan, s, lo[c], c, (1.0 - t[c]) * pre);
+        if (hi >= 0.0) {
+            plan_add(plan, s, hi, c, t[c] * pre);
+        }
+    }
+    plan.slots = plan.counts[2] > 0u ? 3u : plan.counts[1] > 0u ? 2u : 1u;
+    return plan;
+}
+
+// Fills slot j with slot s of fragment f's plan.
+void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale, float post,
+               float pixels) {
+    slot_reach[j] = reach;
+    slot_scale[j] = scale;
+    slot_color[j] = vec4(f.color, f.dioptre);
+    slot_hidden[j] = uvec4(f.size, floatBitsToUint(f.radius));
+    vec3 coef[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
+    [[unroll]] for (uint i = 0u; i < READS; i++) {
+        bool used = i < plan.counts[s];
+        uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
+        coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
+        // An unused read stays harmless: its bound rejects every offset.
+        slot_read[READS * j + i] = vec4(vec2(level_centres[l].xy) + 0.5,
+                                        used ? float(level_block_radius(l) + 1u) : 0.0, coef[i].r);
+    }
+    slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
+    slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
+}
+
+// Read i of slot j at kernel offset d in the region whose origin is `node`.
+vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 extent) {
+    vec4 at = slot_read[READS * j + i];
+    vec3 w = vec3(0.0);
+    // Past the block's zero ring lie other blocks: nothing counts there. An unused read's
+    // bound is 0. (A GPU skips the read here; a CPU implementation reads and discards.)
+    if (all(lessThan(abs(d), vec2(at.z)))) {
+        w = vec3(at.w, gb_r.xy)
+          * textureLod(psf_texture, vec3((node + at.xy + d) / extent, layer), 0.0).rgb;
+    }
+    return w;
+}
+
+vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2 extent) {
+    vec3 w = one_read(j, 0u, gb0.xyz, d, node, layer, extent)
+           + one_read(j, 1u, vec3(gb0.zw, 0.0), d, node, layer, extent);
+    if (READS > 2u) {
+        w += one_read(j, 2u, gb1.xyz, d, node, layer, extent);
+    }
+    return w;
+}
+
+// Per-channel kernel weight of slot j at screen offset d: the local scale's kernel offset, the
+// reads, off axis the four field nodes mixed bilinearly.
+vec3 slot_weight(uint j, vec2 d, vec2 extent) {
+    vec4 s = slot_scale[j];
+    vec2 k = kernel_offset(s.xy, s.zw, d);
+    float layer = slot_reach[j].w;
+    vec4 gb0 = slot_gb[2u * j];
+    vec4 gb1 = slot_gb[2u * j + 1u];
+    vec3 w;
+    if (OFF_AXIS == 0u) {
+        w = slot_reads(j, gb0, gb1, k, vec2(0.0), layer, extent);
+    } else {
+        vec4 weights = slot_node_weights[j];
+        vec4 n01 = slot_nodes[2u * j];
+        vec4 n23 = slot_nodes[2u * j + 1u];
+        w = vec3(0.0);
+        if (weights.x > 0.0) {
+            w += weights.x * slot_reads(j, gb0, gb1, k, n01.xy, layer, extent);
+        }
+        if (weights.y > 0.0) {
+            w += weights.y * slot_reads(j, gb0, gb1, k, n01.zw, layer, extent);
+        }
+        if (weights.z > 0.0) {
+            w += weights.z * slot_reads(j, gb0, gb1, k, n23.xy, layer, extent);
+        }
+        if (weights.w > 0.0) {
+            w += weights.w * slot_reads(j, gb0, gb1, k, n23.zw, layer, extent);
+        }
+    }
+    // A merged block under the per-fragment blend: its s² pixels' coverage compounds.
+    if (PER_FRAGMENT_BLEND != 0u) {
+        w = gb1.w > 1.0 ? vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(gb1.w)) : w;
+    }
+    return w * gb1.z;
+}
+
+// Composites the open group behind what is already there and empties it. Its coverage is
+// its kernels' summed weight (at most 1); its light is the mean over the weight that reaches
+// the pupil, which differs only where a hidden-layer fragment's rays are blocked
+// (pupil_share): the nearer groups' coverage already removed the blocked part of the pupil,
+// so the hidden light fills the rest with what those rays really meet. A group none of whose
+// light gets through takes no coverage.
+void close_group(inout vec3 C, inout vec3 A, inout vec3 Cg, inout vec3 Ag, inout vec3 Gg) {
+    vec3 reaches = step(vec3(1e-30), Gg);
+    vec3 coverage = min(Ag, vec3(1.0)) * reaches;
+    C += (vec3(1.0) - A) * coverage * Cg / max(Gg, vec3(1e-30));
+    A += (vec3(1.0) - A) * coverage;
+    Cg = vec3(0.0);
+    Ag = vec3(0.0);
+    Gg = vec3(0.0);
+}
+
+// What a near fragment hides is unknown where no hidden layer holds it, and
+// dividing by the coverage would fill the hole behind it with its own light (a point light
+// before a distant background gains up to a fifth of its energy). What lies behind is the
+// surface that surrounds the near one from behind: along eight directions from the pixel, past
+// the first step to a farther vergence (more than the group tolerance) within the pixel's own
+// blur reach (the hole is as wide as its kernel), as many pixels of that surface as the reach.
+// Their mean colour (the best guess of a texture whose continuation is hidden) fills the
+// coverage the pixel's groups leave (with hidden layers, what they left); a pixel with no such
+// neighbour (a surface at the back, or the frame's border) keeps the division (so an empty
+// hidden layer changes nothing). src/render/blend.rs::background_behind is the CPU's.
+bool background_behind(uvec2 pixel, out vec3 colour) {
+    colour = vec3(0.0);
+    if (frame.blend_mode != 0u) {
+        return false;
+    }
+    Fragment own = load_fragment(pixel.y * frame.width + pixel.x);
+    int reach = int(ceil(max(own.radius.r, max(own.radius.g, own.radius.b)))) + 1;
+    float found = 0.0;
+    for (uint i = 0u; i < 8u; i++) {
+        ivec2 step_px = ivec2(round(vec2(cos(float(i) * 0.78539816), sin(float(i) * 0.78539816))));
+        float previous = own.dioptre;
+        int taken = 0;
+        float surface = 0.0;
+        for (int s = 1; s <= 2 * reach; s++) {
+            ivec2 q = ivec2(pixel) + s * step_px;
+            if (any(lessThan(q, ivec2(0))) || q.x >= int(frame.width) || q.y >= int(frame.height)) {
+                break;
+            }
+            Fragment g = load_fragment(uint(q.y) * frame.width + uint(q.x));
+            if (taken == 0) {
+                if (s > reach) {
+                    break;
+                }
+                if (previous - g.dioptre > frame.group_tolerance_d) {
+                    surface = g.dioptre;
+                    taken = 1;
+                    colour += g.color;
+                }
+                previous = g.dioptre;
+            } else {
+                if (taken >= reach || abs(g.dioptre - surface) > frame.group_tolerance_d) {
+                    break;
+                }
+                colour += g.color;
+                taken++;
+                surface = g.dioptre;
+            }
+        }
+        found += float(taken);
+    }
+    colour /= max(found, 1.0);
+    return found > 0.0;
+}
+
+// The walk: batches of slots, each visited by the subgroups whose rows it reaches.
+void walk_slots(uint n, uint base, uint ty, vec2 extent) {
+    uint local_index = gl_LocalInvocationIndex;
+    uint row = gl_LocalInvocationID.y;
+    if (local_index < 8u) {
+        row_slots[local_index] = uvec3(0u);
+    }
+    barrier();
+    uint start = 0u;
+    while (start < n) {
+        // 1. Each thread plans one entry's reads and counts its slots.
+        bool loaded = start + local_index < n;
+        Fragment f;
+        ReadPlan plan;
+        vec4 reach;
+        vec4 scale;
+        float post = 1.0;
+        float pixels = 1.0;
+        uint slots = 0u;
+        if (loaded) {
+            f = load_fragment(entries[base + start + local_index].y);
+            vec3 s = local_scale(f.center);
+            // The largest channel radius decides how much of the local scale applies.
+            float rmax = max(f.radius.r, max(f.radius.g, f.radius.b));
+            vec2 c = shrink_for_radius(s.z, rmax);
+            bool scaled = c.x < 1.0;
+            float extent_z = float(textureSize(psf_texture, 0).z);
+            reach = vec4(f.center, fragment_reach(f), (f.index + 0.5) / extent_z);
+            scale = scaled ? vec4(s.xy, c) : vec4(1.0, 0.0, 1.0, 1.0);
+            uint size = block_size(f);
+            float n_px = float(size * size);
+            // Grouped, a merged block's light and the local scale's weight are linear factors
+            // of the reads; the per-fragment blend raises the summed weight to the block's
+            // pixel count first.
+            float local_weight = scaled ? c.x * c.y : 1.0;
+            float pre = grouped ? (size > 1u ? n_px : 1.0) * local_weight : 1.0;
+            post = grouped ? 1.0 : local_weight;
+            pixels = !grouped && size > 1u ? n_px : 1.0;
+            plan = plan_reads(f, pre);
+            slots = plan.slots;
+        }
+        entry_slots[local_index] = slots;
+        if (local_index == 0u) {
+            unsaturated = 0u;
+            batch_taken = 0u;
+        }
+        barrier();
+        // 2. A running sum gives each entry its first slot, in list order.
+        [[unroll]] for (uint stride = 1u; stride < 64u; stride <<= 1u) {
+            uint add = local_index >= stride ? entry_slots[local_index - stride] : 0u;
+            barrier();
+            entry_slots[local_index] += add;
+            barrier();
+        }
+        uint first = entry_slots[local_index] - slots;
+        bool fits = loaded && first + slots <= SLOTS;
+        // 3. The entries that fit fill their slots and mark the thread rows they reach, by the
+        // very test the pixels make below.
+        if (fits) {
+            atomicAdd(batch_taken, 1u);
+            [[unroll]] for (uint k = 0u; k < 3u; k++) {
+                if (k < slots) {
+                    fill_slot(first + k, f, plan, k, reach, scale, post, pixels);
+                }
+            }
+            if (OFF_AXIS != 0u) {
+                uvec4 nodes;
+                vec4 weights;
+                field_corners(f.center, nodes, weights);
+                vec4 n01 = vec4(vec2(node_origin(nodes.x)), vec2(node_origin(nodes.y)));
+                vec4 n23 = vec4(vec2(node_origin(nodes.z)), vec2(node_origin(nodes.w)));
+                [[unroll]] for (uint k = 0u; k < 3u; k++) {
+                    if (k < slots) {
+                        slot_nodes[2u * (first + k)] = n01;
+                        slot_nodes[2u * (first + k) + 1u] = n23;
+                        slot_node_weights[first + k] = weights;
+                    }
+                }
+            }
+            // Bits first … first + slots − 1 of the 96-bit row masks.
+            uvec3 index = uvec3(0u, 32u, 64u);
+            uvec3 lo = uvec3(clamp(ivec3(first) - ivec3(index), ivec3(0), ivec3(32)));
+            uvec3 hi = uvec3(clamp(ivec3(first + slots) - ivec3(index), ivec3(0), ivec3(32)));
+            uvec3 below_hi = mix(uvec3(0xFFFFFFFFu), (uvec3(1u) << hi) - 1u, lessThan(hi, uvec3(32u)));
+            uvec3 below_lo = mix(uvec3(0xFFFFFFFFu), (uvec3(1u) << lo) - 1u, lessThan(lo, uvec3(32u)));
+            uvec3 bits = below_hi & ~below_lo;
+            [[unroll]] for (uint y = 0u; y < 8u; y++) {
+                bool reached = false;
+                [[unroll]] for (uint k = 0u; k < PER_AXIS; k++) {
+                    float py = float(ty * TILE + y + 8u * k) + 0.5;
+                    reached = reached || abs(py - reach.y) <= reach.z;
+                }
+                if (reached) {
+                    atomicOr(row_slots[y].x, bits.x);
+                    atomicOr(row_slots[y].y, bits.y);
+                    atomicOr(row_slots[y].z, bits.z);
+                }
+            }
+        }
+        barrier();
+        // 4. The slots that reach any pixel of this subgroup, in list order: a loop uniform in
+        // the subgroup (lavapipe runs it until all its threads leave it).
+        uvec3 todo = subgroupOr(row_slots[row]);
+        while (any(notEqual(todo, uvec3(0u)))) {
+            bool in_x = todo.x != 0u;
+            bool in_y = !in_x && todo.y != 0u;
+            bool in_z = !in_x && !in_y;
+            uint j = in_x ? uint(findLSB(todo.x))
+                   : in_y ? 32u + uint(findLSB(todo.y)) : 64u + uint(findLSB(todo.z));
+            todo.x = in_x ? todo.x & (todo.x - 1u) : todo.x;
+            todo.y = in_y ? todo.y & (todo.y - 1u) : todo.y;
+            todo.z = in_z ? todo.z & (todo.z - 1u) : todo.z;
+            vec4 g = slot_reach[j];
+            vec4 color = slot_color[j];
+            [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
+                vec2 d = centre[q] - g.xy;
+                if (abs(d.x) <= g.z && abs(d.y) <= g.z) {
+                    vec3 w = slot_weight(j, d, extent);
+                    uvec4 hidden = slot_hidden[j];
+                    vec3 share = pupil_share(hidden.x, uintBitsToFloat(hidden.yzw),
+                                             pupil_inner(hidden.x), d);
+                    if (grouped) {
+                        if (last[q] >= 0.0 && abs(color.w - last[q]) > frame.group_tolerance_d) {
+                            close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
+                        }
+                        Cg[q] += (w * share) * color.rgb;
+                        Ag[q] += w;
+                        Gg[q] += w * share;
+                        last[q] = color.w;
+                    } else {
+                        C[q] += (vec3(1.0) - A[q]) * (w * share) * color.rgb;
+                        A[q] += (vec3(1.0) - A[q]) * (w * share);
+                    }
+                }
+            }
+        }
+        // Early exit: once every pixel of the tile is covered to 1 − ε in every channel by
+        // closed groups (or by the per-fragment blend), what lies behind adds at most ε of its
+        // light; the open group is not closed yet and may still grow, so it does not count.
+        bool saturated = true;
+        [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
+            saturated = saturated && all(greaterThanEqual(A[q], vec3(1.0 - frame.saturation_epsilon)));
+        }
+        if (!saturated || frame.saturation_epsilon <= 0.0) {
+            atomicAdd(unsaturated, 1u);
+        }
+        barrier();
+        bool done = unsaturated == 0u;
+        start += batch_taken;
+        if (local_index < 8u) {
+            row_slots[local_index] = uvec3(0u);
+        }
+        barrier();
+        if (done) {
+            break;
+        }
+    }
+
+}
+
+void main() {
+    load_band();
+    uint tile = band.first_tile + gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+    if (tile >= band.end_tile) {
+        return;
+    }
+    uint tx = tile % frame.tiles_x;
+    uint ty = tile / frame.tiles_x;
+    uint n = counts[tile];
+    if (!list_fits(offsets[tile], n)) {
+        return;
+    }
+    uint base = offsets[tile] - band.first_entry;
+    [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
+        uvec2 pixel = uvec2(tx, ty) * TILE + gl_LocalInvocationID.xy + 8u * uvec2(q % PER_AXIS, q / PER_AXIS);
+        centre[q] = vec2(pixel) + 0.5;
+        C[q] = vec3(0.0);
+        A[q] = vec3(0.0);
+        Cg[q] = vec3(0.0);
+        Ag[q] = vec3(0.0);
+        Gg[q] = vec3(0.0);
+        last[q] = -1.0;
+    }
+    walk_slots(n, base, ty, vec2(textureSize(psf_texture, 0).xy));
+
+    [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
+        close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);
+        uvec2 pixel = uvec2(centre[q]);
+        if (pixel.x < frame.width && pixel.y < frame.height) {
+            vec3 behind;
+            if (any(lessThan(A[q], vec3(1.0))) && background_behind(pixel, behind)) {
+                C[q] += max(vec3(1.0) - A[q], vec3(0.0)) * behind;
+                A[q] = max(A[q], vec3(1.0));
+            }
+            vec3 a = A[q];
+            vec3 color = vec3(a.r > 0.0 ? C[q].r / a.r : 0.0,
+                              a.g > 0.0 ? C[q].g / a.g : 0.0,
+                              a.b > 0.0 ? C[q].b / a.b : 0.0);
+            imageStore(color_out, ivec2(pixel), vec4(color, 1.0));
+        }
+    }
+}
