@@ -144,7 +144,7 @@ impl PixelBlend {
 /// surface as the reach (while its vergence runs on within the tolerance). Their mean colour
 /// is the best guess of a texture whose continuation is hidden; `None` where there is no such
 /// neighbour (a surface at the back; the frame's border keeps the division). The GPU's copy is
-/// `background_behind` in glsl/render/splat/convolve.comp.
+/// `background_behind` in glsl/common/blend.glsl.
 pub fn background_behind(
     (width, height): (usize, usize),
     (x, y): (usize, usize),
