@@ -95,9 +95,67 @@ pub fn ssim<'py>(
     }
 }
 
-// FLIP: another engineer is adding it to the library (crate::metrics) in parallel. Its
-// binding goes here, beside psnr and ssim, as `flip(image, reference, ...)`, registered in
-// `super::module` and declared in python/ocular_render/__init__.pyi.
+/// FLIP (Andersson et al. 2020) of `image` against `reference`, as `ocular metrics` computes
+/// it: LDR-FLIP of linear sRGB clamped to [0, 1], or with `hdr=True` HDR-FLIP over the
+/// automatic exposure range with the ACES tone mapper. `ppd`: pixels per degree of the viewing
+/// condition (default FLIP's, 67.02). Returns the mean error in [0, 1]; with `full=True`
+/// (mean, per-pixel map as an (H, W) float32 array).
+#[pyfunction]
+#[pyo3(signature = (image, reference, ppd = crate::metrics::flip::DEFAULT_PPD, hdr = false, full = false))]
+pub fn flip<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    reference: &Bound<'py, PyAny>,
+    ppd: f64,
+    hdr: bool,
+    full: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let (w, h, a, b) = image_pair(image, reference, 1.0)?;
+    if !(ppd.is_finite() && ppd > 0.0) {
+        return Err(value_error(format!(
+            "ppd {ppd} must be a positive number of pixels per degree"
+        )));
+    }
+    if let Some(bad) = a
+        .iter()
+        .chain(&b)
+        .flat_map(|p| &p[..3])
+        .find(|v| !v.is_finite())
+    {
+        return Err(value_error(format!(
+            "image and reference must be finite (found {bad})"
+        )));
+    }
+    if hdr && a.iter().chain(&b).flat_map(|p| &p[..3]).any(|v| *v < 0.0) {
+        return Err(value_error(
+            "HDR-FLIP takes non-negative linear values; image or reference has a negative one",
+        ));
+    }
+    let map = py.allow_threads(|| {
+        let test = ImageView::new(w, h, &a);
+        let reference = ImageView::new(w, h, &b);
+        if hdr {
+            crate::metrics::flip::hdr_flip(
+                reference,
+                test,
+                ppd,
+                &crate::metrics::flip::HdrSettings::default(),
+            )
+            .map(|f| f.map)
+            .map_err(|e| e.to_string())
+        } else {
+            Ok(crate::metrics::flip::ldr_flip(reference, test, ppd))
+        }
+    });
+    let map = map.map_err(value_error)?;
+    let mean = crate::metrics::flip::FlipStats::of(&map).mean;
+    if full {
+        let map = super::arrays::gray_out(py, w, h, map);
+        Ok((mean, map).into_pyobject(py)?.into_any())
+    } else {
+        Ok(mean.into_pyobject(py)?.into_any())
+    }
+}
 
 /// Reads the colour of an EXR (R, G, B; linear) as an (H, W, 3) float32 array.
 #[pyfunction]

@@ -78,6 +78,7 @@ fn ocular_render_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(eye::eye_presets, m)?)?;
     m.add_function(wrap_pyfunction!(measures::psnr, m)?)?;
     m.add_function(wrap_pyfunction!(measures::ssim, m)?)?;
+    m.add_function(wrap_pyfunction!(measures::flip, m)?)?;
     m.add_function(wrap_pyfunction!(measures::read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(measures::write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(renderer::scenes, m)?)?;

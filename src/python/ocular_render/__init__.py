@@ -4,8 +4,8 @@ Eyes come from presets, eye files, spectacle prescriptions or Zernike wavefronts
 (:class:`Eye`); :func:`psf` computes one point-spread function through an eye;
 :class:`Renderer` owns one Vulkan device and renders colour + depth arrays (or shipped scenes)
 as the eye sees them, reusing its kernels, pipelines and PSF texture from frame to frame while
-the eye's state holds. :func:`psnr` and :func:`ssim` compare images as ``ocular compare``
-does.
+the eye's state holds. :func:`psnr`, :func:`ssim` and :func:`flip` compare images as
+``ocular compare`` and ``ocular metrics`` do.
 
 Arrays: colour is (H, W, 3) float32 linear RGB (cd/m²), depth (H, W) float32 metres along the
 view axis (0 or +inf: background); row 0 is the top. Bad arguments raise ValueError (TypeError
@@ -19,6 +19,7 @@ from ._ocular_render import (
     Renderer,
     __version__,
     eye_presets,
+    flip,
     psf,
     psnr,
     read_exr,
@@ -27,16 +28,13 @@ from ._ocular_render import (
     write_exr,
 )
 
-# FLIP (NVIDIA's perceptual difference) is being added to the library by another engineer;
-# its binding belongs beside psnr and ssim (src/python/measures.rs) and is exported here as
-# `flip` once the library has it.
-
 __all__ = [
     "Eye",
     "Refraction",
     "Renderer",
     "__version__",
     "eye_presets",
+    "flip",
     "psf",
     "psnr",
     "read_exr",

@@ -179,6 +179,24 @@ def ssim(
 def ssim(
     image: _F32, reference: _F32, data_range: float = 1.0, *, full: Literal[True]
 ) -> Tuple[float, _F32]: ...
+@overload
+def flip(
+    image: _F32,
+    reference: _F32,
+    ppd: float = 67.02064327658225,
+    hdr: bool = False,
+    full: Literal[False] = False,
+) -> float:
+    """FLIP's mean error in [0, 1] (LDR, or HDR-FLIP with hdr=True), as `ocular metrics`."""
+@overload
+def flip(
+    image: _F32,
+    reference: _F32,
+    ppd: float = 67.02064327658225,
+    hdr: bool = False,
+    *,
+    full: Literal[True],
+) -> Tuple[float, _F32]: ...
 def read_exr(path: _Path) -> _F32:
     """An EXR's colour as (H, W, 3) float32."""
 def write_exr(path: _Path, array: _F32) -> None:
