@@ -219,9 +219,10 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     if args.views.is_some() && args.truth != TruthArg::Views {
         return Err(Error::input("--views applies to --truth views"));
     }
-    if !(args.flip_ppd.is_finite() && (1.0..=10_000.0).contains(&args.flip_ppd)) {
+    if !crate::metrics::flip::ppd_in_range(args.flip_ppd) {
+        let (lo, hi) = crate::metrics::flip::PPD_RANGE;
         return Err(Error::input(format!(
-            "--flip-ppd {} is outside 1 to 10000 pixels per degree",
+            "--flip-ppd {} is outside {lo} to {hi} pixels per degree",
             args.flip_ppd
         )));
     }

@@ -107,7 +107,7 @@ fn parse_monitor(text: &str) -> std::result::Result<(f64, u32, f64), String> {
 
 /// The range a `--ppd` may take: below 1 a pixel spans more than a degree, above 10 000 the
 /// filters would span millions of pixels.
-const PPD_RANGE: (f64, f64) = (1.0, 10_000.0);
+use crate::metrics::flip::{ppd_in_range, PPD_RANGE};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -225,7 +225,7 @@ struct Report {
 pub fn run(args: &MetricsArgs) -> Result<()> {
     let ppd = match (args.ppd, args.monitor) {
         (Some(p), _) => {
-            if !(p.is_finite() && (PPD_RANGE.0..=PPD_RANGE.1).contains(&p)) {
+            if !ppd_in_range(p) {
                 return Err(Error::input(format!(
                     "--ppd {p} is outside {} to {} pixels per degree",
                     PPD_RANGE.0, PPD_RANGE.1
@@ -235,7 +235,7 @@ pub fn run(args: &MetricsArgs) -> Result<()> {
         }
         (None, Some((width_m, res_x, dist_m))) => {
             let p = flip::pixels_per_degree(width_m, f64::from(res_x), dist_m);
-            if !(PPD_RANGE.0..=PPD_RANGE.1).contains(&p) {
+            if !ppd_in_range(p) {
                 return Err(Error::input(format!(
                     "--monitor {width_m},{res_x},{dist_m} gives {p:.3} pixels per degree, outside \
                      {} to {}",

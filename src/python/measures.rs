@@ -111,9 +111,10 @@ pub fn flip<'py>(
     full: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (w, h, a, b) = image_pair(image, reference, 1.0)?;
-    if !(ppd.is_finite() && ppd > 0.0) {
+    if !crate::metrics::flip::ppd_in_range(ppd) {
+        let (lo, hi) = crate::metrics::flip::PPD_RANGE;
         return Err(value_error(format!(
-            "ppd {ppd} must be a positive number of pixels per degree"
+            "ppd {ppd} is outside {lo} to {hi} pixels per degree"
         )));
     }
     if let Some(bad) = a

@@ -36,6 +36,14 @@ pub fn pixels_per_degree(width_m: f64, resolution_x: f64, distance_m: f64) -> f6
 /// (≈ 67.02 pixels per degree).
 pub const DEFAULT_PPD: f64 = 0.7 * (3840.0 / 0.7) * std::f64::consts::PI / 180.0;
 
+/// The viewing conditions every front door accepts, in pixels per degree.
+pub const PPD_RANGE: (f64, f64) = (1.0, 10_000.0);
+
+/// Whether `ppd` is a viewing condition FLIP is computed for (finite, within PPD_RANGE).
+pub fn ppd_in_range(ppd: f64) -> bool {
+    ppd.is_finite() && (PPD_RANGE.0..=PPD_RANGE.1).contains(&ppd)
+}
+
 /// Linear sRGB planes of an image, clamped to [0, 1] (what an LDR display can show).
 fn clamped_planes(image: ImageView<'_>) -> [Plane; 3] {
     [0, 1, 2].map(|c| {
