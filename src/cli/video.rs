@@ -205,14 +205,7 @@ impl Timeline {
                 };
                 dn + (df - dn) * t
             }
-            None => {
-                // Far focus distances are infinity (accommodating to 1e-10 D is ill-posed).
-                if state.focus_m > 0.0 {
-                    crate::render::focus::focus_d_of_distance_m(state.focus_m)
-                } else {
-                    0.0
-                }
-            }
+            None => crate::render::frame_plan::scene_focus_d(state.focus_m),
         }
     }
 }
@@ -224,15 +217,6 @@ fn planning_frames(count: usize) -> Vec<usize> {
         return (0..count).collect();
     }
     (0..MAX).map(|k| k * (count - 1) / (MAX - 1)).collect()
-}
-
-/// An eye for `option` (`--eye` or `--side-by-side`), with errors naming that option.
-fn load_eye_for(option: &str, spec: &str) -> Result<Eye> {
-    match crate::eye::file::resolve(spec) {
-        Ok(file) => Ok(file.eye),
-        Err(Error::Input(message)) => Err(Error::Input(format!("{option}: {message}"))),
-        Err(other) => Err(other),
-    }
 }
 
 fn sha256_of_debug(values: &[&dyn std::fmt::Debug]) -> String {
@@ -334,9 +318,9 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     // The pupil model's age also sets the amplitude of accommodation, as in render.
     let eyes = args.correction.labelled_eyes(
         &args.eye,
-        load_eye_for("--eye", &args.eye)?,
+        crate::render::frame_plan::load_eye("--eye", &args.eye)?,
         args.side_by_side.as_deref(),
-        |spec| load_eye_for("--side-by-side", spec),
+        |spec| crate::render::frame_plan::load_eye("--side-by-side", spec),
         Some((args.age, crate::eye::age::HofstetterLine::Mean)),
     )?;
     if args.output.exists() && !args.output.is_dir() {
@@ -481,7 +465,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
                     Some(&frame),
                     (width, height),
                     fov_y_deg,
-                ),
+                )?,
             });
         }
     }

@@ -4,6 +4,7 @@
 pub mod blend;
 pub mod focus;
 pub mod frame;
+pub mod frame_plan;
 pub mod projection;
 pub mod raster;
 pub mod reference;
