@@ -8,7 +8,7 @@ use crate::eye::correction::{
 };
 use crate::eye::Eye;
 use crate::render::frame_plan::{corrected_eye, Correction};
-pub use crate::render::frame_plan::{spectacle_magnification, IolPower, Physiology};
+pub use crate::render::frame_plan::{IolPower, Physiology};
 use crate::{Error, Result};
 
 #[derive(clap::Args, Debug, Clone, Default)]

@@ -7,9 +7,9 @@ use crate::Result;
 
 mod bench;
 mod compare;
+mod compare_files;
 pub(crate) mod correction;
 mod devices;
-mod edge_band;
 mod eye;
 mod eye_plot;
 mod kernels;

@@ -166,6 +166,119 @@ pub struct RenderArgs {
     pub output: PathBuf,
 }
 
+/// The frame through its kernels (splat, reference or slices): a scene through splat stays on
+/// the GPU, drawn again in splat's own submission.
+fn render_frame(
+    args: &RenderArgs,
+    ctx: &Context,
+    input: &mut Input,
+    eye: Eye,
+    (needs, options): (
+        &crate::psf::plan::SceneNeeds,
+        &crate::render::frame::KernelOptions,
+    ),
+    splat: crate::render::splat::SplatSettings,
+    state: EyeState,
+) -> Result<(
+    crate::render::frame::RenderedFrame,
+    super::render_output::KernelInfo,
+)> {
+    let kernels = super::prepare_kernels(&eye, needs, options)?;
+    let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
+    let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
+    let missed = kernels
+        .report
+        .as_ref()
+        .map(|r| r.columns.iter().map(|c| c.missed_energy).collect());
+    let seconds_kernels = kernels.seconds;
+    let max_radius = kernels.grid.max_radius_px;
+    let field = kernels.field.as_ref().map(|f| f.plan.clone());
+    let mut renderer = FrameRenderer::new(ctx, eye, kernels, options.settings.clone(), splat);
+    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
+        .hidden
+        .iter()
+        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
+        .collect();
+    let frame_input = FrameInput {
+        width: input.width,
+        height: input.height,
+        color: &input.color,
+        depth_m: &input.depth_m,
+        fov_y_deg: input.fov_y_deg,
+        hidden_layers: if args.method == Method::Splat {
+            &hidden
+        } else {
+            &[]
+        },
+    };
+    let frame = match &mut input.raster {
+        // the frame stays on the GPU: drawn again in splat's submission, not uploaded
+        Some((rasterizer, scene, layers)) if args.method == Method::Splat => {
+            let scene_state = scene.at_time(args.time);
+            let size = (input.width, input.height);
+            let gap_d = args.splat.blend.settings().group_tolerance_d;
+            let mut recorded = rasterizer
+                .scene_frame(ctx, &scene_state, size)
+                .peeled(*layers, gap_d);
+            renderer.render_recorded(&mut recorded, state)?
+        }
+        _ => renderer.render(&frame_input, state, args.method)?,
+    };
+
+    let info = super::render_output::KernelInfo {
+        from_cache,
+        psfs,
+        missed,
+        seconds: seconds_kernels,
+        max_radius,
+        field,
+    };
+    Ok((frame, info))
+}
+
+/// The options checked on their own, before any file or device is opened; the splat
+/// settings they give.
+fn check_args(args: &RenderArgs) -> Result<crate::render::splat::SplatSettings> {
+    let output_ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(output_ext.as_deref(), Some("png") | Some("exr")) {
+        return Err(Error::input(format!(
+            "-o {}: the output must end in .png or .exr",
+            args.output.display()
+        )));
+    }
+    let splat = args.splat.settings()?;
+    if let Some(fov) = args.fov_y {
+        check_fov(fov)?;
+    }
+    if args.method == Method::Views && args.color.is_some() {
+        return Err(Error::input(
+            "--method views rasterises a scene from points across the pupil; it cannot render \
+             a --color frame (one view): give a scene",
+        ));
+    }
+    if args.views.is_some() && args.method != Method::Views {
+        return Err(Error::input("--views applies to --method views"));
+    }
+    if args.layers.is_some() && args.method != Method::Splat {
+        return Err(Error::input(
+            "--layers applies to --method splat (reference and slices see the visible layer only)",
+        ));
+    }
+    check_file_options(args)?;
+    if let Some(ev) = args.exposure {
+        if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
+            return Err(Error::input(format!(
+                "--exposure {ev} must be a number of EV in [-64, 64]"
+            )));
+        }
+    }
+    Ok(splat)
+}
+
 /// Options that only mean something for file input are refused with a scene rather than
 /// ignored (clap's `requires` is not checked once --scene is given).
 fn check_file_options(args: &RenderArgs) -> Result<()> {
@@ -399,43 +512,7 @@ impl Input {
 }
 
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
-    let output_ext = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(output_ext.as_deref(), Some("png") | Some("exr")) {
-        return Err(Error::input(format!(
-            "-o {}: the output must end in .png or .exr",
-            args.output.display()
-        )));
-    }
-    let splat = args.splat.settings()?;
-    if let Some(fov) = args.fov_y {
-        check_fov(fov)?;
-    }
-    if args.method == Method::Views && args.color.is_some() {
-        return Err(Error::input(
-            "--method views rasterises a scene from points across the pupil; it cannot render \
-             a --color frame (one view): give a scene",
-        ));
-    }
-    if args.views.is_some() && args.method != Method::Views {
-        return Err(Error::input("--views applies to --method views"));
-    }
-    if args.layers.is_some() && args.method != Method::Splat {
-        return Err(Error::input(
-            "--layers applies to --method splat (reference and slices see the visible layer only)",
-        ));
-    }
-    check_file_options(args)?;
-    if let Some(ev) = args.exposure {
-        if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
-            return Err(Error::input(format!(
-                "--exposure {ev} must be a number of EV in [-64, 64]"
-            )));
-        }
-    }
+    let splat = check_args(args)?;
     let (eye, physiology) = args.correction.apply(
         &load_eye(&args.eye)?,
         Some((args.age, args.accommodation_line)),
@@ -502,56 +579,15 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             None,
         );
     }
-    let kernels = super::prepare_kernels(&eye, &needs, &options)?;
-    let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
-    let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
-    let missed = kernels
-        .report
-        .as_ref()
-        .map(|r| r.columns.iter().map(|c| c.missed_energy).collect());
-    let seconds_kernels = kernels.seconds;
-    let max_radius = kernels.grid.max_radius_px;
-    let field = kernels.field.as_ref().map(|f| f.plan.clone());
-    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
-    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
-        .hidden
-        .iter()
-        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
-        .collect();
-    let frame_input = FrameInput {
-        width: input.width,
-        height: input.height,
-        color: &input.color,
-        depth_m: &input.depth_m,
-        fov_y_deg: input.fov_y_deg,
-        hidden_layers: if args.method == Method::Splat {
-            &hidden
-        } else {
-            &[]
-        },
-    };
-    let frame = match &mut input.raster {
-        // the frame stays on the GPU: drawn again in splat's submission, not uploaded
-        Some((rasterizer, scene, layers)) if args.method == Method::Splat => {
-            let scene_state = scene.at_time(args.time);
-            let size = (input.width, input.height);
-            let gap_d = args.splat.blend.settings().group_tolerance_d;
-            let mut recorded = rasterizer
-                .scene_frame(&ctx, &scene_state, size)
-                .peeled(*layers, gap_d);
-            renderer.render_recorded(&mut recorded, state)?
-        }
-        _ => renderer.render(&frame_input, state, args.method)?,
-    };
-
-    let info = super::render_output::KernelInfo {
-        from_cache,
-        psfs,
-        missed,
-        seconds: seconds_kernels,
-        max_radius,
-        field,
-    };
+    let (frame, info) = render_frame(
+        args,
+        &ctx,
+        &mut input,
+        eye,
+        (&needs, &options),
+        splat,
+        state,
+    )?;
     super::render_output::finish(
         args,
         &ctx,

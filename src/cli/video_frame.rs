@@ -16,7 +16,7 @@ const IDENTITY: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
 
 /// The pupil options of a video frame: Watson–Yellott at the scene's luminance, else at the
 /// frame's mean luminance, where neither `--pupil-mm` nor the scene gives a pupil.
-fn pupil_asked(args: &VideoArgs) -> PupilAsked<'static> {
+pub(super) fn pupil_asked(args: &VideoArgs) -> PupilAsked<'static> {
     PupilAsked {
         given_mm: args.pupil_mm,
         luminance_cdm2: None,
