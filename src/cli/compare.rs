@@ -225,11 +225,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         .collect();
     let frames = rendered.rows(&truth, layers, &judged_frames);
     let (methods, maps) = judge_rows(&judge, &frames)?;
-    let truth_shares = truth_shares(
-        args.truth_in.is_some(),
-        truth.method == Method::Views,
-        args.splat.off_axis,
-    );
+    let truth_shares = shares(args, truth.method);
     print_table(args, &at, truth_shares, &views_convergence, &methods);
     if let Some(path) = &args.truth_out {
         image_io::write_exr_rgba(
@@ -597,6 +593,12 @@ fn judge_rows(
         );
     }
     Ok((methods, maps))
+}
+
+/// What the truth shares with the methods it judges, as the report words it.
+fn shares(args: &CompareArgs, truth_method: Method) -> &'static str {
+    let views = truth_method == Method::Views;
+    truth_shares(args.truth_in.is_some(), views, args.splat.off_axis)
 }
 
 fn print_table(
