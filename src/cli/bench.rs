@@ -13,7 +13,7 @@ use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
-use crate::render::frame::{FrameRenderer, Method};
+use crate::render::frame::{EyeState, FrameRenderer, Method};
 use crate::render::splat::FrameInput;
 use crate::render::Rasterizer;
 use crate::scene::{FrameState, Scene};
@@ -325,6 +325,20 @@ struct Precompute {
     seconds_total: f64,
 }
 
+impl Precompute {
+    fn of(kernels: &crate::render::frame::PreparedKernels) -> Precompute {
+        let report = kernels.report.as_ref();
+        Precompute {
+            from_cache: report.is_none(),
+            psfs: report.map_or(0, |r| r.psfs_computed),
+            seconds_eye_optics: report.map_or(0.0, |r| r.seconds_optics),
+            seconds_psfs: report.map_or(0.0, |r| r.seconds_psfs),
+            seconds_kernels: report.map_or(0.0, |r| r.seconds_kernels),
+            seconds_total: kernels.seconds,
+        }
+    }
+}
+
 pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     if args.frames == 0 {
         return Err(Error::input("--frames must be at least 1"));
@@ -342,18 +356,10 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let (width, height) = args.size;
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
-    let (focus_d, pupil_mm) = (eye_state.focus_d, eye_state.pupil_mm);
     let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
-    let precompute = Precompute {
-        from_cache: kernels.report.is_none(),
-        psfs: kernels.report.as_ref().map_or(0, |r| r.psfs_computed),
-        seconds_eye_optics: kernels.report.as_ref().map_or(0.0, |r| r.seconds_optics),
-        seconds_psfs: kernels.report.as_ref().map_or(0.0, |r| r.seconds_psfs),
-        seconds_kernels: kernels.report.as_ref().map_or(0.0, |r| r.seconds_kernels),
-        seconds_total: kernels.seconds,
-    };
+    let precompute = Precompute::of(&kernels);
     let max_radius_px = kernels.grid.max_radius_px;
     let field = kernels.field.as_ref().map(|f| f.plan.axes.clone());
     let baseline_inputs = args.baseline.then(|| (eye.clone(), kernels.clone()));
@@ -372,7 +378,6 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         fov_y_deg: screen.fov_y_deg,
         hidden_layers: &[],
     };
-
     let runs = if args.baseline { 2 } else { 1 };
     let bar = frame_bar((runs * (args.warmup + args.frames)) as u64);
     let scene_state = scene.at_time(0.0);
@@ -386,68 +391,31 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         gap_d,
     };
     let timed = time_frames(&mut renderer, &mut scene_input, true, eye_state, args, &bar)?;
-    let baseline = if let Some((eye, kernels)) = baseline_inputs {
-        let old = crate::render::splat::SplatSettings {
-            blend: crate::render::blend::BlendSettings::paper(),
-            saturation_epsilon: 0.0,
-            steady_state: false,
-            ..splat
-        };
-        let mut old_renderer =
-            FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), old);
-        let old_timed = time_frames(
-            &mut old_renderer,
-            &mut scene_input,
-            false,
-            eye_state,
-            args,
-            &bar,
-        )?;
-        let (new_ms, old_ms) = (
-            stat("wall", &timed.walls).mean_ms,
-            stat("wall", &old_timed.walls).mean_ms,
-        );
-        Some(Baseline {
-            what: "the seed paper's blend and narrow-field geometry, the frame read back to the \
-                   host and uploaded again, lists planned on the host and the PSF texture \
-                   rebuilt every frame, no early exit",
-            wall_ms_per_frame: stat("wall", &old_timed.walls),
-            gpu_total: stat("total", &old_timed.totals),
-            counters: old_timed.counters,
-            speedup: old_ms / new_ms,
-        })
-    } else {
-        None
+    let baseline = match baseline_inputs {
+        Some((eye, kernels)) => {
+            let old =
+                FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), paper(splat));
+            let mut run = BaselineRun {
+                renderer: old,
+                scene: &mut scene_input,
+                eye_state,
+                bar: &bar,
+            };
+            Some(run.time(args, &timed)?)
+        }
+        None => None,
     };
     bar.finish_and_clear();
-    let TimedFrames {
-        per_pass,
-        totals,
-        walls,
-        list_entries,
-        live_fragments,
-        kernel_evaluations,
-        psf_texture_bytes,
-        counters,
-    } = timed;
-    let splat_total = stat("total", &totals);
-    let mut methods = Vec::new();
-    if args.compare_methods {
-        let splat_seconds = stat("wall", &walls).mean_ms / 1e3;
-        methods.push(MethodTime {
-            method: "splat",
-            seconds: splat_seconds,
-            ratio_to_splat: 1.0,
-        });
-        for method in [Method::Reference, Method::Slices] {
-            let out = renderer.render(&input, eye_state, method)?;
-            methods.push(MethodTime {
-                method: method.name(),
-                seconds: out.seconds,
-                ratio_to_splat: out.seconds / splat_seconds,
-            });
-        }
-    }
+    let methods = if args.compare_methods {
+        method_times(
+            &mut renderer,
+            &input,
+            eye_state,
+            stat("wall", &timed.walls).mean_ms / 1e3,
+        )?
+    } else {
+        Vec::new()
+    };
     let info = ctx.device_info();
     let report = Report {
         device: info.name.clone(),
@@ -459,20 +427,21 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         layers,
         warmup: args.warmup,
         frames: args.frames,
-        focus_d,
-        pupil_mm,
+        focus_d: eye_state.focus_d,
+        pupil_mm: eye_state.pupil_mm,
         precompute,
-        passes: per_pass.iter().map(|(n, v)| stat(n, v)).collect(),
-        total: splat_total,
-        wall_ms_per_frame: stat("wall", &walls),
-        list_entries,
-        live_fragments,
-        kernel_evaluations,
-        evaluations_per_pixel: kernel_evaluations as f64 / (f64::from(width) * f64::from(height)),
+        passes: timed.per_pass.iter().map(|(n, v)| stat(n, v)).collect(),
+        total: stat("total", &timed.totals),
+        wall_ms_per_frame: stat("wall", &timed.walls),
+        list_entries: timed.list_entries,
+        live_fragments: timed.live_fragments,
+        kernel_evaluations: timed.kernel_evaluations,
+        evaluations_per_pixel: timed.kernel_evaluations as f64
+            / (f64::from(width) * f64::from(height)),
         max_radius_px,
-        psf_texture_bytes,
+        psf_texture_bytes: timed.psf_texture_bytes,
         field,
-        counters,
+        counters: timed.counters,
         baseline,
         methods,
     };
@@ -487,6 +456,74 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The splatting settings before this work: the seed paper's blend and narrow field, no
+/// steady state, no early exit.
+fn paper(splat: crate::render::splat::SplatSettings) -> crate::render::splat::SplatSettings {
+    crate::render::splat::SplatSettings {
+        blend: crate::render::blend::BlendSettings::paper(),
+        saturation_epsilon: 0.0,
+        steady_state: false,
+        ..splat
+    }
+}
+
+/// The baseline's frames, timed as the product's were.
+struct BaselineRun<'r, 'a, 's> {
+    renderer: FrameRenderer,
+    scene: &'r mut SceneInput<'a, 's>,
+    eye_state: EyeState,
+    bar: &'r indicatif::ProgressBar,
+}
+
+impl BaselineRun<'_, '_, '_> {
+    fn time(&mut self, args: &BenchArgs, timed: &TimedFrames) -> Result<Baseline> {
+        let old_timed = time_frames(
+            &mut self.renderer,
+            &mut *self.scene,
+            false,
+            self.eye_state,
+            args,
+            self.bar,
+        )?;
+        let (new_ms, old_ms) = (
+            stat("wall", &timed.walls).mean_ms,
+            stat("wall", &old_timed.walls).mean_ms,
+        );
+        Ok(Baseline {
+            what: "the seed paper's blend and narrow-field geometry, the frame read back to the \
+                   host and uploaded again, lists planned on the host and the PSF texture \
+                   rebuilt every frame, no early exit",
+            wall_ms_per_frame: stat("wall", &old_timed.walls),
+            gpu_total: stat("total", &old_timed.totals),
+            counters: old_timed.counters,
+            speedup: old_ms / new_ms,
+        })
+    }
+}
+
+/// Splat's wall time per frame against one frame of the reference and of the slices.
+fn method_times(
+    renderer: &mut FrameRenderer,
+    input: &FrameInput<'_>,
+    eye_state: EyeState,
+    splat_seconds: f64,
+) -> Result<Vec<MethodTime>> {
+    let mut methods = vec![MethodTime {
+        method: "splat",
+        seconds: splat_seconds,
+        ratio_to_splat: 1.0,
+    }];
+    for method in [Method::Reference, Method::Slices] {
+        let out = renderer.render(input, eye_state, method)?;
+        methods.push(MethodTime {
+            method: method.name(),
+            seconds: out.seconds,
+            ratio_to_splat: out.seconds / splat_seconds,
+        });
+    }
+    Ok(methods)
 }
 
 fn frame_bar(total: u64) -> indicatif::ProgressBar {

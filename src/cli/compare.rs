@@ -6,16 +6,18 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use super::compare_files::{judged_name, map_names, maps_folder, read_truth, write_maps};
 use super::outputs::Outputs;
 use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
-use crate::metrics::flip::{ldr_flip, FlipStats};
-use crate::metrics::{psnr, ssim, ssim_false_colour, ImageView};
-use crate::render::frame::{FrameRenderer, Method, RenderedFrame};
+use crate::image_io::{self, ImageRgba, Tonemap};
+use crate::render::edge_band::edge_band;
+use crate::render::frame::{EyeState, FrameRenderer, KernelOptions, Method, RenderedFrame};
+use crate::render::judge::{exposed, truth_shares, Judge, MethodResult, ViewsConvergence};
 use crate::render::splat::FrameInput;
+use crate::render::views::ViewsImage;
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -122,39 +124,6 @@ pub enum TruthArg {
     Views,
 }
 
-/// How far the views truth is from converged: the change when its views double (the even
-/// half against all of them), on the displayed image.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct ViewsConvergence {
-    pub views: u32,
-    pub half_views: u32,
-    /// PSNR (dB) and MSSIM of the half-views image against the full one.
-    pub psnr_db: f64,
-    pub mssim: f64,
-    /// Largest change of a displayed channel value (0–1).
-    pub max_abs_change: f64,
-    pub seconds_raster: f64,
-    pub seconds_accumulate: f64,
-}
-
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct MethodResult {
-    pub method: String,
-    pub seconds: f64,
-    pub psnr_db: f64,
-    pub mssim: f64,
-    pub speedup_vs_reference: f64,
-    /// Mean LDR-FLIP of the displayed image against the truth's, at the report's `flip_ppd`.
-    pub flip_mean: f64,
-    /// GPU time of all passes (splat only).
-    pub gpu_ms: Option<f64>,
-    /// Depth layers the method saw.
-    pub layers: u32,
-    /// Quality over the occlusion-edge band (pixels within the local blur radius of a depth
-    /// discontinuity).
-    pub edge_band: super::edge_band::BandQuality,
-}
-
 #[derive(serde::Serialize)]
 struct Report {
     scene: String,
@@ -181,41 +150,141 @@ struct Report {
     methods: Vec<MethodResult>,
 }
 
-/// What the ground truth has in common with splat, printed with every comparison.
-const TRUTH_SHARES: &str = "ground truth: the exact PSF of every pixel's vergence; it shares the \
-blend (depth groups), the pinhole's local layout and the PSFs with splat, so it judges splat's \
-kernel approximations (interpolation over distance and radius, merging, half-float texels), \
-not the blend or the optics";
-
-/// What the off-axis reference has in common with off-axis splat.
-const FIELD_TRUTH_SHARES: &str = "ground truth: the exact PSF of every pixel's vergence and \
-direction (the eye traced for every 1° field bin, no lattice); it shares the blend, the \
-pinhole's local layout and the PSF computation of a direction with splat, so it judges the \
-field lattice and its interpolation as well as the kernel approximations, not the optics";
-
-/// A truth read with --truth-in: what it shares is what the run that saved it shared.
-const LOADED_TRUTH_SHARES: &str = "ground truth: read with --truth-in; it shares with these \
-methods what the run that saved it said (e.g. an off-axis reference judging on-axis splat \
-measures what the field's aberrations change)";
-
-/// What the views truth has in common with the methods it judges.
-const VIEWS_SHARES: &str = "ground truth: multi-view accumulation over the pupil (geometric \
-optics, rasterised from each pupil point, each channel shifted by the eye's ray aberration); it \
-shares the scene, the focused eye and its Zernike coefficients per wavelength with splat, not \
-the kernels, the blend or the single visible layer; it leaves out diffraction, so it judges \
-where geometric blur dominates";
-
-/// The displayed image: linear values scaled by the exposure, clamped to [0, 1].
-fn exposed(image: &[[f32; 4]], scale: f32) -> Vec<[f32; 4]> {
-    image
-        .iter()
-        .map(|p| [0, 1, 2].map(|c| (p[c] * scale).clamp(0.0, 1.0)))
-        .map(|v| [v[0], v[1], v[2], 1.0])
-        .collect()
-}
-
 pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let splat = args.splat.settings()?;
+    check_args(args)?;
+    // Declared before the outputs so that it is dropped after their temporaries are.
+    let maps_created = match &args.maps {
+        Some(dir) => Some(maps_folder(dir)?),
+        None => None,
+    };
+    let mut outputs = planned_outputs(args)?;
+    let (truth_in, judged) = read_images(args)?;
+    let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
+    let scene = Scene::load(&args.scene)?;
+    let ctx = Context::new(&cli.context_options())?;
+    let (width, height) = args.size;
+    let (frame, eye_state, screen) =
+        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
+    let options = kernel_options(args)?;
+    let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
+    let mut notes = Vec::new();
+    let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
+    for n in &notes {
+        println!("note: {n}");
+    }
+    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    renderer.slice_count = args.slices;
+    if let Some(bin) = args.truth_bin_d {
+        renderer.reference_dioptre_bin_d = bin;
+    }
+    let input = FrameInput {
+        width,
+        height,
+        color: &frame.color,
+        depth_m: &frame.depth_m,
+        fov_y_deg: screen.fov_y_deg,
+        hidden_layers: &[],
+    };
+    let at = Frames {
+        ctx: &ctx,
+        scene: &scene,
+        input: &input,
+        eye_state,
+        gap_d: splat.blend.group_tolerance_d,
+    };
+    let (truth, convergence_images) = render_truth(&at, &mut renderer, args, truth_in, &options)?;
+    let rendered = render_methods(&at, &mut renderer, args, truth.method, layers)?;
+    // Compare what a person sees: every image at the input frame's automatic exposure.
+    let exposure_ev =
+        Tonemap::auto_exposure_ev(&ImageRgba::new(width, height, frame.color.clone()));
+    let band = edge_band(
+        &frame.depth_m,
+        (width, height),
+        screen.fov_y_deg,
+        &renderer.kernels().grid,
+        (eye_state.pupil_mm, eye_state.focus_d),
+        f64::from(splat.blend.group_tolerance_d),
+    );
+    let scale = 2f32.powf(exposure_ev);
+    let judge = Judge {
+        width: width as usize,
+        height: height as usize,
+        scale,
+        truth: exposed(&truth.color, scale),
+        band: &band,
+        flip_ppd: args.flip_ppd,
+        reference_seconds: rendered.reference.as_ref().unwrap_or(&truth).seconds,
+    };
+    let views_convergence = convergence_images
+        .as_ref()
+        .map(|i| judge.views_convergence(i));
+    let judged_frames: Vec<(RenderedFrame, String)> = judged
+        .into_iter()
+        .map(|(name, image)| (read_frame(image, truth.method), name))
+        .collect();
+    let frames = rendered.rows(&truth, layers, &judged_frames);
+    let (methods, maps) = judge_rows(&judge, &frames)?;
+    let truth_shares = shares(args, truth.method);
+    print_table(args, &at, truth_shares, &views_convergence, &methods);
+    if let Some(path) = &args.truth_out {
+        image_io::write_exr_rgba(
+            outputs.temporary(path),
+            &ImageRgba::new(width, height, truth.color.clone()),
+        )?;
+    }
+    if let Some(dir) = &args.maps {
+        write_maps(&mut outputs, dir, args.size, &frames, &maps, exposure_ev)?;
+    }
+    if let Some(path) = &args.json {
+        let report = Report {
+            scene: args.scene.clone(),
+            eye: args.eye.clone(),
+            width,
+            height,
+            focus_d: eye_state.focus_d,
+            pupil_mm: eye_state.pupil_mm,
+            device: ctx.device_info().name.clone(),
+            truth: if truth.method == Method::Views {
+                "views"
+            } else {
+                "reference"
+            },
+            truth_shares,
+            truth_bin_d: (truth.method == Method::Reference && args.truth_in.is_none())
+                .then_some(renderer.reference_dioptre_bin_d),
+            views_convergence,
+            splat_warmed_up: !args.no_warmup,
+            flip_ppd: args.flip_ppd,
+            display_exposure_ev: exposure_ev,
+            methods,
+        };
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
+        image_io::write_text_atomic(outputs.temporary(path), &text)?;
+    }
+    outputs.commit()?;
+    if let Some(mut created) = maps_created {
+        created.keep();
+    }
+    print_written(args);
+    Ok(())
+}
+
+fn print_written(args: &CompareArgs) {
+    if let Some(dir) = &args.maps {
+        println!(
+            "wrote images and SSIM maps (1.0 → navy, ≤ 0.9 → red) to {}",
+            dir.display()
+        );
+    }
+    for path in [&args.truth_out, &args.json].into_iter().flatten() {
+        println!("wrote {}", path.display());
+    }
+}
+
+/// Options out of range or at odds with each other, refused before anything is read.
+fn check_args(args: &CompareArgs) -> Result<()> {
     if args.views.is_some() && args.truth != TruthArg::Views {
         return Err(Error::input("--views applies to --truth views"));
     }
@@ -256,11 +325,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         }
         rows.push(name);
     }
-    // Declared before the outputs so that it is dropped after their temporaries are.
-    let maps_created = match &args.maps {
-        Some(dir) => Some(maps_folder(dir)?),
-        None => None,
-    };
+    Ok(())
+}
+
+/// Every file this run writes, checked writable before minutes of rendering.
+fn planned_outputs(args: &CompareArgs) -> Result<Outputs> {
     let mut outputs = Outputs::new();
     if let Some(path) = &args.truth_out {
         outputs.add("--truth-out", path, &["exr"])?;
@@ -282,6 +351,15 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         }
     }
     outputs.probe()?;
+    Ok(outputs)
+}
+
+/// The `--judge` images, each with its row's name.
+type Judged = Vec<(String, ImageRgba)>;
+
+/// The `--truth-in` image and the `--judge` images (named by their rows), checked against the
+/// frame's size.
+fn read_images(args: &CompareArgs) -> Result<(Option<ImageRgba>, Judged)> {
     if args.truth_bin_d.is_some() && args.truth_in.is_some() && args.truth == TruthArg::Reference {
         return Err(Error::input(
             "--truth-bin-d applies to a rendered reference; --truth-in reads one",
@@ -292,7 +370,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         .as_ref()
         .map(|p| read_truth("--truth-in", p))
         .transpose()?;
-    let judged: Vec<(String, ImageRgba)> = args
+    let judged: Judged = args
         .judge
         .iter()
         .map(|p| Ok((judged_name(p), read_truth("--judge", p)?)))
@@ -309,13 +387,11 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             )));
         }
     }
-    let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
-    let scene = Scene::load(&args.scene)?;
-    let ctx = Context::new(&cli.context_options())?;
-    let (width, height) = args.size;
-    let (frame, eye_state, screen) =
-        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
-    let (focus_d, pupil_mm) = (eye_state.focus_d, eye_state.pupil_mm);
+    Ok((truth_in, judged))
+}
+
+/// The kernel options the comparison's flags set, validated with the flags named.
+fn kernel_options(args: &CompareArgs) -> Result<KernelOptions> {
     let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     options.reference_axes.objects =
         crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
@@ -335,102 +411,148 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
              axis only)",
         ));
     }
-    options.field_width_px = args.splat.off_axis.then_some(width);
-    let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
-    let mut notes = Vec::new();
-    let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
-    for n in &notes {
-        println!("note: {n}");
-    }
-    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
-    renderer.slice_count = args.slices;
-    if let Some(bin) = args.truth_bin_d {
-        renderer.reference_dioptre_bin_d = bin;
-    }
-    let input = FrameInput {
-        width,
-        height,
-        color: &frame.color,
-        depth_m: &frame.depth_m,
-        fov_y_deg: screen.fov_y_deg,
-        hidden_layers: &[],
-    };
+    options.field_width_px = args.splat.off_axis.then_some(args.size.0);
+    Ok(options)
+}
 
+/// What every method renders from.
+struct Frames<'a> {
+    ctx: &'a Context,
+    scene: &'a Scene,
+    input: &'a FrameInput<'a>,
+    eye_state: EyeState,
+    /// The blend's group tolerance (D), which peeling separates layers by.
+    gap_d: f32,
+}
+
+/// A frame read from a file: no time, so no speed-up either.
+fn read_frame(image: ImageRgba, method: Method) -> RenderedFrame {
+    RenderedFrame {
+        color: image.pixels,
+        method,
+        seconds: f64::NAN,
+        timings: None,
+        stats: None,
+    }
+}
+
+/// The ground truth: read with --truth-in, or rendered (the reference, or the views truth
+/// with the images its convergence is measured from).
+fn render_truth(
+    at: &Frames<'_>,
+    renderer: &mut FrameRenderer,
+    args: &CompareArgs,
+    truth_in: Option<ImageRgba>,
+    options: &KernelOptions,
+) -> Result<(RenderedFrame, Option<ViewsImage>)> {
     let truth_method = match args.truth {
         TruthArg::Reference => Method::Reference,
         TruthArg::Views => Method::Views,
     };
-    let mut convergence_images = None;
-    let truth = match (&args.truth_in, truth_in) {
-        (Some(path), Some(image)) => {
-            if (image.width, image.height) != (width, height) {
-                return Err(Error::input(format!(
-                    "--truth-in {} is {}×{}, the frame is {width}×{height}",
-                    path.display(),
-                    image.width,
-                    image.height
-                )));
-            }
-            RenderedFrame {
-                color: image.pixels,
-                method: truth_method,
-                seconds: f64::NAN,
-                timings: None,
-                stats: None,
-            }
+    let (width, height) = args.size;
+    if let (Some(path), Some(image)) = (&args.truth_in, truth_in) {
+        if (image.width, image.height) != (width, height) {
+            return Err(Error::input(format!(
+                "--truth-in {} is {}×{}, the frame is {width}×{height}",
+                path.display(),
+                image.width,
+                image.height
+            )));
         }
-        _ if truth_method == Method::Views => {
-            let started = std::time::Instant::now();
-            let state = scene.at_time(0.0);
-            let column = crate::psf::defocus::ColumnOptics::new(
-                renderer.eye(),
-                pupil_mm,
-                focus_d,
-                renderer.kernels().grid.wavelengths_nm,
-                &options.settings,
-            )?;
-            let image = crate::render::views::render(
-                &ctx,
-                &mut crate::render::Rasterizer::new(&ctx)?,
-                &state,
-                (width, height),
-                &column,
-                focus_d,
-                args.views.unwrap_or(crate::render::views::DEFAULT_VIEWS),
-            )?;
-            let seconds = started.elapsed().as_secs_f64();
-            let color = image.color.clone();
-            convergence_images = Some(image);
-            RenderedFrame {
-                color,
-                method: Method::Views,
-                seconds,
-                timings: None,
-                stats: None,
-            }
-        }
-        _ => renderer.render(&input, eye_state, Method::Reference)?,
+        return Ok((read_frame(image, truth_method), None));
+    }
+    if truth_method != Method::Views {
+        let truth = renderer.render(at.input, at.eye_state, Method::Reference)?;
+        return Ok((truth, None));
+    }
+    let started = std::time::Instant::now();
+    let state = at.scene.at_time(0.0);
+    let column = crate::psf::defocus::ColumnOptics::new(
+        renderer.eye(),
+        at.eye_state.pupil_mm,
+        at.eye_state.focus_d,
+        renderer.kernels().grid.wavelengths_nm,
+        &options.settings,
+    )?;
+    let image = crate::render::views::render(
+        at.ctx,
+        &mut crate::render::Rasterizer::new(at.ctx)?,
+        &state,
+        (width, height),
+        &column,
+        at.eye_state.focus_d,
+        args.views.unwrap_or(crate::render::views::DEFAULT_VIEWS),
+    )?;
+    let truth = RenderedFrame {
+        color: image.color.clone(),
+        method: Method::Views,
+        seconds: started.elapsed().as_secs_f64(),
+        timings: None,
+        stats: None,
     };
-    let reference_frame = if truth_method == Method::Views {
-        Some(renderer.render(&input, eye_state, Method::Reference)?)
+    Ok((truth, Some(image)))
+}
+
+/// The frames judged against the truth.
+struct Rendered {
+    /// The reference, where the views truth judges it.
+    reference: Option<RenderedFrame>,
+    splat: RenderedFrame,
+    layered: Option<RenderedFrame>,
+    slices: Option<RenderedFrame>,
+}
+
+impl Rendered {
+    /// Every row in its order: the truth, the rendered methods, the judged files.
+    fn rows<'a>(
+        &'a self,
+        truth: &'a RenderedFrame,
+        layers: u32,
+        judged: &'a [(RenderedFrame, String)],
+    ) -> Vec<(&'a RenderedFrame, String, u32)> {
+        [
+            Some((truth, truth.method.name().to_string(), 1)),
+            self.reference.as_ref().map(|f| (f, "reference".into(), 1)),
+            Some((&self.splat, "splat".into(), 1)),
+            self.layered
+                .as_ref()
+                .map(|f| (f, "splat-layers".into(), layers)),
+            self.slices.as_ref().map(|f| (f, "slices".into(), 1)),
+        ]
+        .into_iter()
+        .flatten()
+        .chain(judged.iter().map(|(f, name)| (f, name.clone(), 1)))
+        .collect()
+    }
+}
+
+fn render_methods(
+    at: &Frames<'_>,
+    renderer: &mut FrameRenderer,
+    args: &CompareArgs,
+    truth_method: Method,
+    layers: u32,
+) -> Result<Rendered> {
+    let (input, eye_state) = (at.input, at.eye_state);
+    let reference = if truth_method == Method::Views {
+        Some(renderer.render(input, eye_state, Method::Reference)?)
     } else {
         None
     };
     // The first splat frame compiles shaders and uploads the kernels: time the second.
     if !args.no_warmup {
-        renderer.render(&input, eye_state, Method::Splat)?;
+        renderer.render(input, eye_state, Method::Splat)?;
     }
-    let splat_frame = renderer.render(&input, eye_state, Method::Splat)?;
+    let splat = renderer.render(input, eye_state, Method::Splat)?;
     // The layered frame is peeled and splatted in one submission, its layers never on the
     // host (tests/engine.rs: the same image as the layers read back and uploaded).
-    let layered_frame = if layers > 1 {
-        let state = scene.at_time(0.0);
-        let mut raster = crate::render::Rasterizer::new(&ctx)?;
-        let gap_d = splat.blend.group_tolerance_d;
+    let layered = if layers > 1 {
+        let state = at.scene.at_time(0.0);
+        let mut raster = crate::render::Rasterizer::new(at.ctx)?;
         let mut layered = || {
             let mut recorded = raster
-                .scene_frame(&ctx, &state, args.size)
-                .peeled(layers, gap_d);
+                .scene_frame(at.ctx, &state, args.size)
+                .peeled(layers, at.gap_d);
             renderer.render_recorded(&mut recorded, eye_state)
         };
         layered()?;
@@ -439,151 +561,63 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         None
     };
     // slices have no off-axis variant: leave them out rather than compare the on-axis PSF
-    let slices_frame = if args.no_slices || args.splat.off_axis {
+    let slices = if args.no_slices || args.splat.off_axis {
         None
     } else {
-        Some(renderer.render(&input, eye_state, Method::Slices)?)
+        Some(renderer.render(input, eye_state, Method::Slices)?)
     };
+    Ok(Rendered {
+        reference,
+        splat,
+        layered,
+        slices,
+    })
+}
 
-    let (w, h) = (width as usize, height as usize);
-    // Compare what a person sees: every image at the input frame's automatic exposure.
-    let exposure_ev =
-        Tonemap::auto_exposure_ev(&ImageRgba::new(width, height, frame.color.clone()));
-    let scale = 2f32.powf(exposure_ev);
-    let truth01 = exposed(&truth.color, scale);
-    let reference_seconds = reference_frame.as_ref().unwrap_or(&truth).seconds;
-    let views_convergence = convergence_images.as_ref().map(|image| {
-        let full = exposed(&image.color, scale);
-        let half = exposed(&image.half_color, scale);
-        let quality = ssim(
-            ImageView::new(w, h, &half),
-            ImageView::new(w, h, &full),
-            1.0,
-        );
-        let max_abs_change = half
-            .iter()
-            .zip(&full)
-            .flat_map(|(a, b)| (0..3).map(move |c| f64::from((a[c] - b[c]).abs())))
-            .fold(0.0, f64::max);
-        ViewsConvergence {
-            views: image.views,
-            half_views: image.views.div_ceil(2),
-            psnr_db: psnr(
-                ImageView::new(w, h, &half),
-                ImageView::new(w, h, &full),
-                1.0,
-            ),
-            mssim: quality.mean,
-            max_abs_change,
-            seconds_raster: image.seconds_raster,
-            seconds_accumulate: image.seconds_accumulate,
-        }
-    });
-    let mut methods = Vec::new();
-    let mut maps = Vec::new();
+/// Every row judged, with its SSIM map; a note where the frame is under SSIM's window.
+fn judge_rows(
+    judge: &Judge<'_>,
+    frames: &[(&RenderedFrame, String, u32)],
+) -> Result<(Vec<MethodResult>, Vec<Vec<f32>>)> {
+    let (mut methods, mut maps) = (Vec::new(), Vec::new());
     let mut window_px = 11;
-    let judged_frames: Vec<(RenderedFrame, String)> = judged
-        .into_iter()
-        .map(|(name, image)| {
-            let frame = RenderedFrame {
-                color: image.pixels,
-                method: truth_method,
-                seconds: f64::NAN,
-                timings: None,
-                stats: None,
-            };
-            (frame, name)
-        })
-        .collect();
-    let frames: Vec<(&RenderedFrame, String, u32)> = [
-        Some((&truth, truth_method.name().to_string(), 1)),
-        reference_frame.as_ref().map(|f| (f, "reference".into(), 1)),
-        Some((&splat_frame, "splat".into(), 1)),
-        layered_frame
-            .as_ref()
-            .map(|f| (f, "splat-layers".into(), layers)),
-        slices_frame.as_ref().map(|f| (f, "slices".into(), 1)),
-    ]
-    .into_iter()
-    .flatten()
-    .chain(judged_frames.iter().map(|(f, name)| (f, name.clone(), 1)))
-    .collect();
-    let band = super::edge_band::edge_band(
-        &frame.depth_m,
-        (width, height),
-        screen.fov_y_deg,
-        &renderer.kernels().grid,
-        (pupil_mm, focus_d),
-        f64::from(splat.blend.group_tolerance_d),
-    );
-    for (frame, name, frame_layers) in &frames {
-        let (frame, frame_layers) = (*frame, *frame_layers);
-        if let Some((count, first)) = non_finite(&frame.color, w) {
-            return Err(Error::input(format!(
-                "the {} image has {count} pixels that are not finite (first at x = {}, y = {}); \
-                 no metric is computed from them",
-                frame.method.name(),
-                first.0,
-                first.1
-            )));
-        }
-        let image = exposed(&frame.color, scale);
-        let quality = ssim(
-            ImageView::new(w, h, &image),
-            ImageView::new(w, h, &truth01),
-            1.0,
-        );
-        let edge_band = super::edge_band::band_quality(&image, &truth01, &quality.map, &band, w);
-        methods.push(MethodResult {
-            method: name.clone(),
-            layers: frame_layers,
-            edge_band,
-            seconds: frame.seconds,
-            psnr_db: psnr(
-                ImageView::new(w, h, &image),
-                ImageView::new(w, h, &truth01),
-                1.0,
-            ),
-            mssim: quality.mean,
-            flip_mean: FlipStats::of(&ldr_flip(
-                ImageView::new(w, h, &truth01),
-                ImageView::new(w, h, &image),
-                args.flip_ppd,
-            ))
-            .mean,
-            // a truth read with --truth-in has no time (NaN), nor a speed-up
-            speedup_vs_reference: if frame.seconds.is_nan() {
-                f64::NAN
-            } else {
-                reference_seconds / frame.seconds.max(1e-12)
-            },
-            gpu_ms: frame.timings.as_ref().map(|t| t.total_ms()),
-        });
-        maps.push(quality.map);
-        window_px = quality.window_px;
+    for (frame, name, layers) in frames {
+        let row = judge.row(frame, name, *layers)?;
+        methods.push(row.result);
+        maps.push(row.ssim_map);
+        window_px = row.window_px;
     }
     if window_px != 11 {
         println!(
             "note: the frame is under SSIM's 11-pixel window; MSSIM uses a {window_px}×{window_px} window"
         );
     }
+    Ok((methods, maps))
+}
+
+/// What the truth shares with the methods it judges, as the report words it.
+fn shares(args: &CompareArgs, truth_method: Method) -> &'static str {
+    let views = truth_method == Method::Views;
+    truth_shares(args.truth_in.is_some(), views, args.splat.off_axis)
+}
+
+fn print_table(
+    args: &CompareArgs,
+    at: &Frames<'_>,
+    truth_shares: &str,
+    views_convergence: &Option<ViewsConvergence>,
+    methods: &[MethodResult],
+) {
+    let (width, height) = args.size;
+    let (focus_d, pupil_mm) = (at.eye_state.focus_d, at.eye_state.pupil_mm);
     println!(
         "{} through eye {} at {width}×{height}, focus {focus_d:.3} D, pupil {pupil_mm:.2} mm ({})",
         args.scene,
         args.eye,
-        ctx.device_info().name
+        at.ctx.device_info().name
     );
-    let truth_shares = if args.truth_in.is_some() {
-        LOADED_TRUTH_SHARES
-    } else if truth_method == Method::Views {
-        VIEWS_SHARES
-    } else if args.splat.off_axis {
-        FIELD_TRUTH_SHARES
-    } else {
-        TRUTH_SHARES
-    };
     println!("  {truth_shares}");
-    if let Some(c) = &views_convergence {
+    if let Some(c) = views_convergence {
         println!(
             "  views: {} (doubling from {} changes the image by {:.2} dB PSNR, MSSIM {:.5}, at most {:.4})",
             c.views, c.half_views, c.psnr_db, c.mssim, c.max_abs_change
@@ -601,7 +635,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         "PSNR dB",
         "MSSIM"
     );
-    for m in &methods {
+    for m in methods {
         let db = if m.psnr_db.is_infinite() {
             "∞".to_string()
         } else {
@@ -626,158 +660,6 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             m.method, db, m.mssim, m.flip_mean, seconds, speedup, band_db, m.edge_band.mssim
         );
     }
-    if let Some(path) = &args.truth_out {
-        image_io::write_exr_rgba(
-            outputs.temporary(path),
-            &ImageRgba::new(width, height, truth.color.clone()),
-        )?;
-    }
-    if let Some(dir) = &args.maps {
-        let shown = Tonemap {
-            exposure_ev,
-            mode: TonemapMode::Clamp,
-        };
-        for (i, frame) in frames.iter().enumerate() {
-            let name = if i == 0 { "truth" } else { frame.1.as_str() };
-            let image = ImageRgba::new(width, height, frame.0.color.clone());
-            image_io::write_png(
-                outputs.temporary(&dir.join(format!("{name}.png"))),
-                &image,
-                shown,
-            )?;
-        }
-        let flat = Tonemap {
-            exposure_ev: 0.0,
-            mode: TonemapMode::Clamp,
-        };
-        for (frame, map) in frames[1..].iter().zip(&maps[1..]) {
-            let name = format!("ssim_{}", frame.1);
-            let rgb: Vec<[f32; 4]> = ssim_false_colour(map, 0.9)
-                .iter()
-                .map(|p| [0, 1, 2].map(|c| image_io::srgb_decode(p[c])))
-                .map(|v| [v[0], v[1], v[2], 1.0])
-                .collect();
-            image_io::write_png(
-                outputs.temporary(&dir.join(format!("{name}.png"))),
-                &ImageRgba::new(width, height, rgb),
-                flat,
-            )?;
-        }
-    }
-    if let Some(path) = &args.json {
-        let report = Report {
-            scene: args.scene.clone(),
-            eye: args.eye.clone(),
-            width,
-            height,
-            focus_d,
-            pupil_mm,
-            device: ctx.device_info().name.clone(),
-            truth: if truth_method == Method::Views {
-                "views"
-            } else {
-                "reference"
-            },
-            truth_shares,
-            truth_bin_d: (truth_method == Method::Reference && args.truth_in.is_none())
-                .then_some(renderer.reference_dioptre_bin_d),
-            views_convergence,
-            splat_warmed_up: !args.no_warmup,
-            flip_ppd: args.flip_ppd,
-            display_exposure_ev: exposure_ev,
-            methods,
-        };
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-        image_io::write_text_atomic(outputs.temporary(path), &text)?;
-    }
-    outputs.commit()?;
-    if let Some(mut created) = maps_created {
-        created.keep();
-    }
-    if let Some(dir) = &args.maps {
-        println!(
-            "wrote images and SSIM maps (1.0 → navy, ≤ 0.9 → red) to {}",
-            dir.display()
-        );
-    }
-    for path in [&args.truth_out, &args.json].into_iter().flatten() {
-        println!("wrote {}", path.display());
-    }
-    Ok(())
-}
-
-/// The files `--maps` writes, without extension.
-fn map_names(no_slices: bool, views: bool, layers: bool) -> Vec<&'static str> {
-    let mut names = vec!["truth"];
-    let mut judged = vec![];
-    if views {
-        judged.push(("reference", "ssim_reference"));
-    }
-    judged.push(("splat", "ssim_splat"));
-    if layers {
-        judged.push(("splat-layers", "ssim_splat-layers"));
-    }
-    if !no_slices {
-        judged.push(("slices", "ssim_slices"));
-    }
-    names.extend(judged.iter().map(|j| j.0));
-    names.extend(judged.iter().map(|j| j.1));
-    names
-}
-
-/// A `--maps` folder this run created, removed again (if still empty) unless kept.
-struct CreatedFolder(Option<PathBuf>);
-
-impl CreatedFolder {
-    fn keep(&mut self) {
-        self.0 = None;
-    }
-}
-
-impl Drop for CreatedFolder {
-    fn drop(&mut self) {
-        if let Some(dir) = &self.0 {
-            let _ = std::fs::remove_dir(dir);
-        }
-    }
-}
-
-/// The `--maps` folder: an existing folder, or a new one in an existing folder.
-fn maps_folder(dir: &std::path::Path) -> Result<CreatedFolder> {
-    if dir.is_dir() {
-        return Ok(CreatedFolder(None));
-    }
-    if dir.exists() {
-        return Err(Error::input(format!(
-            "--maps {}: is a file; give a folder",
-            dir.display()
-        )));
-    }
-    std::fs::create_dir(dir)
-        .map_err(|e| Error::input(format!("--maps {}: cannot create it ({e})", dir.display())))?;
-    Ok(CreatedFolder(Some(dir.to_path_buf())))
-}
-
-/// An image for `--truth-in` or `--judge`, refused if any colour value is not finite (metrics
-/// of NaN are not numbers).
-fn read_truth(option: &str, path: &PathBuf) -> Result<ImageRgba> {
-    let image = image_io::read_exr_rgba(path)?;
-    if let Some((count, (x, y))) = non_finite(&image.pixels, image.width as usize) {
-        return Err(Error::input(format!(
-            "{option} {}: {count} pixels are not finite (first at x = {x}, y = {y}); an image \
-             to judge or judge by must hold finite colour",
-            path.display()
-        )));
-    }
-    Ok(image)
-}
-
-/// The row of a `--judge` image: its file name without the extension.
-fn judged_name(path: &std::path::Path) -> String {
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned());
-    stem.filter(|s| !s.is_empty())
-        .unwrap_or_else(|| "judged".to_string())
 }
 
 /// `--truth-bin-d`: a dioptre bin from 0.0001 to 0.1.
@@ -790,12 +672,4 @@ fn parse_truth_bin_d(text: &str) -> std::result::Result<f64, String> {
         return Err(format!("{bin} is outside 0.0001 to 0.1 D"));
     }
     Ok(bin)
-}
-
-/// How many pixels have a non-finite R, G or B, and the first one's (x, y).
-fn non_finite(pixels: &[[f32; 4]], width: usize) -> Option<(usize, (usize, usize))> {
-    let bad = |p: &[f32; 4]| !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite());
-    let first = pixels.iter().position(bad)?;
-    let count = pixels.iter().filter(|p| bad(p)).count();
-    Some((count, (first % width.max(1), first / width.max(1))))
 }

@@ -2,18 +2,14 @@
 //! accommodation, shared by render, video, compare, kernels and `eye measure`. Each value is
 //! range-checked where clap parses it, so a bad one is a one-line error naming the option.
 
-use crate::eye::age::{hofstetter_amplitude_d, HofstetterLine, MAX_AMPLITUDE_D};
+use crate::eye::age::{HofstetterLine, MAX_AMPLITUDE_D};
 use crate::eye::correction::{
-    emmetropic_iol_power_d, parse_rx, Iol, Spectacle, DEFAULT_VERTEX_MM, IOL_RANGE_D,
-    VERTEX_RANGE_MM,
+    parse_rx, Spectacle, DEFAULT_VERTEX_MM, IOL_RANGE_D, VERTEX_RANGE_MM,
 };
 use crate::eye::Eye;
+use crate::render::frame_plan::{corrected_eye, Correction};
+pub use crate::render::frame_plan::{IolPower, Physiology};
 use crate::{Error, Result};
-
-/// Pupil and wavelength at which `--iol-d auto` makes the eye emmetropic: a photopic pupil
-/// at the accommodation wavelength.
-pub const AUTO_IOL_PUPIL_MM: f64 = 3.0;
-pub const AUTO_IOL_WAVELENGTH_NM: f64 = 549.0;
 
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct CorrectionArgs {
@@ -38,13 +34,6 @@ pub struct CorrectionArgs {
     /// accommodation_max_d or the age model's.
     #[arg(long, value_name = "D", value_parser = parse_amplitude_d, allow_hyphen_values = true)]
     pub accommodation_max_d: Option<f64>,
-}
-
-/// `--iol-d`: a power, or the emmetropic one.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum IolPower {
-    Dioptres(f64),
-    Auto,
 }
 
 fn number(text: &str) -> std::result::Result<f64, String> {
@@ -83,35 +72,6 @@ pub(crate) fn parse_amplitude_d(text: &str) -> std::result::Result<f64, String> 
     range(number(text)?, (0.0, MAX_AMPLITUDE_D), "D")
 }
 
-/// Where the amplitude of accommodation came from, for reports.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct Physiology {
-    /// Amplitude of accommodation (D); null = unlimited.
-    pub accommodation_max_d: Option<f64>,
-    pub accommodation_source: String,
-    /// The correction in `--correct` form, with its vertex distance.
-    pub correction: Option<String>,
-    pub iol_d: Option<f64>,
-    /// How the spectacle maps directions (2×2 on tangents, x right, y up; see
-    /// `Spectacle::angular_magnification`): what the renderer warps scenes by.
-    pub spectacle_magnification: Option<[[f64; 2]; 2]>,
-}
-
-/// The angular magnification of `eye`'s spectacle, seen from the bare eye's entrance pupil
-/// (paraxial, at the renderer's green wavelength).
-pub(crate) fn spectacle_magnification(eye: &Eye) -> Result<Option<[[f64; 2]; 2]>> {
-    let Some(spectacle) = eye.correction else {
-        return Ok(None);
-    };
-    let mut bare = eye.clone();
-    bare.correction = None;
-    let sys = bare
-        .system()
-        .map_err(|err| Error::input(format!("--correct: {err}")))?;
-    let pupil_mm = crate::eye::paraxial::paraxial(&sys, 549.0, 0.0).entrance_pupil_z_mm;
-    Ok(Some(spectacle.angular_magnification(pupil_mm)))
-}
-
 impl CorrectionArgs {
     /// Whether any correction option was given.
     pub fn corrects(&self) -> bool {
@@ -125,57 +85,14 @@ impl CorrectionArgs {
         eye: &Eye,
         age: Option<(f64, HofstetterLine)>,
     ) -> Result<(Eye, Physiology)> {
-        let mut e = eye.clone();
-        let source = if let Some(a) = self.accommodation_max_d {
-            e.accommodation_max_d = Some(a);
-            "--accommodation-max-d".to_string()
-        } else if e.accommodation_max_d.is_some() {
-            "the eye file's accommodation_max_d".to_string()
-        } else if let Some((years, line)) = age {
-            e.accommodation_max_d = Some(hofstetter_amplitude_d(years, line));
-            format!(
-                "Hofstetter's {} line at {years} years",
-                format!("{line:?}").to_lowercase()
-            )
-        } else {
-            "unlimited".to_string()
+        let correction = Correction {
+            spectacle: self.correct,
+            vertex_mm: self.vertex_mm,
+            contact: self.correct_contact,
+            iol: self.iol_d,
+            accommodation_max_d: self.accommodation_max_d,
         };
-        if let Some(mut s) = self.correct {
-            s.vertex_mm = if self.correct_contact {
-                0.0
-            } else {
-                self.vertex_mm.unwrap_or(DEFAULT_VERTEX_MM)
-            };
-            e.correction = Some(s);
-        }
-        if let Some(p) = self.iol_d {
-            let power_d = match p {
-                IolPower::Dioptres(d) => d,
-                IolPower::Auto => {
-                    emmetropic_iol_power_d(&e, AUTO_IOL_PUPIL_MM, AUTO_IOL_WAVELENGTH_NM)
-                        .map_err(|err| Error::input(format!("--iol-d auto: {err}")))?
-                }
-            };
-            e.iol = Some(Iol { power_d });
-        }
-        e.validate()
-            .map_err(|err| Error::input(format!("--correct/--iol-d: {err}")))?;
-        let physiology = Physiology {
-            accommodation_max_d: if e.iol.is_some() {
-                Some(0.0)
-            } else {
-                e.accommodation_max_d
-            },
-            accommodation_source: if e.iol.is_some() {
-                "an IOL does not accommodate".into()
-            } else {
-                source
-            },
-            correction: e.correction.map(|s| describe(&s)),
-            iol_d: e.iol.map(|i| i.power_d),
-            spectacle_magnification: spectacle_magnification(&e)?,
-        };
-        Ok((e, physiology))
+        corrected_eye(eye, &correction, age)
     }
 }
 
@@ -228,15 +145,6 @@ impl CorrectionArgs {
 
 fn e_notation(eye: &Eye) -> Option<String> {
     eye.correction.map(|s| s.notation())
-}
-
-/// `-6.50 +0.00 x 180 at 12 mm` (or `as a contact lens`).
-pub fn describe(s: &Spectacle) -> String {
-    if s.vertex_mm == 0.0 {
-        format!("{} (contact lens)", s.notation())
-    } else {
-        format!("{} at {} mm", s.notation(), s.vertex_mm)
-    }
 }
 
 /// Checks a vertex distance given outside `CorrectionArgs` (`eye refract`).

@@ -14,8 +14,8 @@ use crate::psf::cache::{cached, default_cache_dir, grid_key, write_grid, CacheOu
 use crate::psf::field::FieldAxes;
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::DioptreAxis;
-use crate::psf::plan::{plan_for_scene, SceneNeeds};
 use crate::psf::preview;
+use crate::psf::request::{grid_settings, scene_grid};
 use crate::{Error, Result};
 
 #[derive(Debug, Args)]
@@ -189,27 +189,7 @@ struct Summary<'a> {
 }
 
 pub fn run(args: &KernelsArgs) -> Result<()> {
-    if let Some(w) = args.width {
-        if !(16..=16384).contains(&w) {
-            return Err(Error::input(format!(
-                "--width {w} is not allowed; need 16 to 16384 pixels"
-            )));
-        }
-    }
-    let auto = args.field_deg.as_deref().map(str::trim) == Some("auto");
-    let field = match &args.field_deg {
-        Some(_) if auto => None,
-        Some(text) => Some(FieldAxes::parse(text).map_err(Error::input)?),
-        None => None,
-    };
-    if args.width.is_some() && !auto {
-        return Err(Error::input("--width is only used by --field-deg auto"));
-    }
-    if (auto || field.is_some()) && (args.preview.is_some() || args.plot.is_some()) {
-        return Err(Error::input(
-            "--field-deg writes one grid per direction; --preview and --plot draw a single grid",
-        ));
-    }
+    let (auto, field) = field_option(args)?;
     let mut outputs = super::outputs::Outputs::new();
     match &field {
         Some(f) => super::kernels_field::register(&mut outputs, &args.output, f)?,
@@ -224,61 +204,13 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
     }
     outputs.probe()?;
     let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
-    let mut axes = GridAxes::default();
-    if let Some(text) = &args.wavelengths_nm {
-        let wl = parse_list("wavelengths-nm", text)?;
-        axes.wavelengths_nm = wl.try_into().map_err(|_| {
-            Error::input("--wavelengths-nm: exactly three values (R,G,B) are required")
-        })?;
-    }
-    if let Some(text) = &args.objects {
-        axes.objects = parse_objects(text)?;
-    }
-    if let Some(text) = &args.focus_d {
-        axes.focus_d = parse_list("focus-d", text)?;
-    }
-    if let Some(text) = &args.pupils_mm {
-        axes.pupils_mm = parse_list("pupils-mm", text)?;
-    }
-    axes.validate()
-        .map_err(|e| Error::input(format!("--{e}")))?;
-    let screen = Screen {
-        fov_y_deg: args.fov_y,
-        height_px: args.height,
-    };
-    screen
-        .validate()
-        .map_err(|e| Error::input(format!("--{e}")))?;
-    let settings = KernelSettings {
-        max_radius_cap: args.rmax_cap,
-        energy: args.energy,
-        ..KernelSettings::default()
-    };
-    settings.validate().map_err(|e| {
-        Error::input(
-            e.replace("max_radius_cap", "--rmax-cap")
-                .replace("energy", "--energy"),
-        )
-    })?;
-    let mut skipped = 0;
-    let mut notes = Vec::new();
-    if let Some(range) = &args.scene_d {
-        let (lo, hi) = parse_range("scene-d", range)?;
-        let plan = plan_for_scene(
-            &SceneNeeds {
-                dioptre_min: lo,
-                dioptre_max: hi,
-                focus_d: axes.focus_d.clone(),
-                pupils_mm: axes.pupils_mm.clone(),
-                screen,
-            },
-            &axes,
-        )
-        .map_err(|e| Error::input(format!("--scene-d: {e}")))?;
-        skipped = plan.skipped_psfs;
-        notes = plan.notes;
-        axes = plan.axes;
-    }
+    let Planned {
+        axes,
+        screen,
+        settings,
+        skipped,
+        notes,
+    } = planned_grid(args)?;
     let dir = if args.no_cache {
         None
     } else {
@@ -286,29 +218,10 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
     };
     let mut field = field;
     if auto {
-        let width = args
-            .width
-            .unwrap_or(((args.height as f64) * 16.0 / 9.0).round() as u32);
-        let plan = super::kernels_field::plan(&eye, &axes, &screen, width)?;
-        for n in &plan.notes {
-            eprintln!("note: {n}");
-        }
-        eprintln!(
-            "field plan: {} × {} directions over ±{:.1}° × ±{:.1}°, interpolation error {:.4} µm \
-             (tolerance {} µm)",
-            plan.axes.h_deg.len(),
-            plan.axes.v_deg.len(),
-            plan.axes.h_deg.last().copied().unwrap_or(0.0),
-            plan.axes.v_deg.last().copied().unwrap_or(0.0),
-            plan.worst_error_um,
-            plan.tolerance_um
-        );
-        let mut fresh = super::outputs::Outputs::new();
-        super::kernels_field::register(&mut fresh, &args.output, &plan.axes)?;
-        fresh.probe()?;
+        let (fresh, axes) = auto_field(args, &eye, &axes, &screen)?;
         drop(outputs);
         outputs = fresh;
-        field = Some(plan.axes);
+        field = Some(axes);
     }
     if let Some(f) = &field {
         return super::kernels_field::run(
@@ -332,18 +245,7 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         compute_grid(&eye, &axes, &screen, &settings, &progress)
     })?;
     bars.finish();
-    if let Some(r) = &report {
-        for w in &r.warnings {
-            eprintln!("warning: {w}");
-        }
-    }
-    match &outcome {
-        CacheOutcome::Stored {
-            warning: Some(w), ..
-        } => eprintln!("warning: {w}"),
-        CacheOutcome::WriteFailed(w) => eprintln!("warning: {w}"),
-        _ => {}
-    }
+    print_warnings(report.as_ref(), &outcome);
     write_grid(outputs.temporary(&args.output), &grid, &key)?;
     if let Some(p) = &args.preview {
         preview::write_png(outputs.temporary(p), &preview::contact_sheet(&grid))?;
@@ -371,47 +273,167 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
             .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
         println!("{text}");
     } else {
-        let source = match &outcome {
-            CacheOutcome::Hit(p) => format!("loaded from cache {}", p.display()),
-            _ => format!("computed in {:.1} s", summary.seconds),
-        };
-        println!(
-            "{}: {} sets (pupils {:?} mm × focus {:?} D), {} objects {:.3}..{:.3} D, Rmax {} px, \
-             {:.1} MiB per set; {} PSFs ({} skipped), {source}",
-            summary.output,
-            summary.sets,
-            grid.pupils_mm,
-            grid.focus_d,
-            grid.objects.count,
-            grid.objects.min_d,
-            grid.objects.max_d(),
-            grid.max_radius_px,
-            summary.bytes_per_set as f64 / (1 << 20) as f64,
-            summary.psfs,
-            skipped,
-        );
-        for n in &notes {
-            println!("  plan: {n}");
-        }
-        if let Some(r) = &report {
-            for c in &r.columns {
-                println!(
-                    "  pupil {:.2} mm, focus {:.3} D: lens {:.3} mm{}, residual R/G/B {:+.3} {:+.3} {:+.3} D, beta degree {:?}, PSFs by FFT {:?}, missed pupil energy {:.1e} {:.1e} {:.1e}",
-                    c.pupil_mm,
-                    c.focus_d,
-                    c.lens_diameter_mm,
-                    if c.beyond_far_point { " (beyond far point: relaxed)" } else { "" },
-                    c.residual_d[0],
-                    c.residual_d[1],
-                    c.residual_d[2],
-                    c.beta_degree,
-                    c.fft_psfs,
-                    c.missed_energy[0],
-                    c.missed_energy[1],
-                    c.missed_energy[2],
-                );
-            }
-        }
+        print_summary(&summary, &grid);
     }
     Ok(())
+}
+
+/// `--field-deg`: whether it is `auto`, and the lattice it gives otherwise; with the options
+/// that only make sense with (or without) it.
+fn field_option(args: &KernelsArgs) -> Result<(bool, Option<FieldAxes>)> {
+    if let Some(w) = args.width {
+        if !(16..=16384).contains(&w) {
+            return Err(Error::input(format!(
+                "--width {w} is not allowed; need 16 to 16384 pixels"
+            )));
+        }
+    }
+    let auto = args.field_deg.as_deref().map(str::trim) == Some("auto");
+    let field = match &args.field_deg {
+        Some(_) if auto => None,
+        Some(text) => Some(FieldAxes::parse(text).map_err(Error::input)?),
+        None => None,
+    };
+    if args.width.is_some() && !auto {
+        return Err(Error::input("--width is only used by --field-deg auto"));
+    }
+    if (auto || field.is_some()) && (args.preview.is_some() || args.plot.is_some()) {
+        return Err(Error::input(
+            "--field-deg writes one grid per direction; --preview and --plot draw a single grid",
+        ));
+    }
+    Ok((auto, field))
+}
+
+/// The grid the options ask for, checked and (with --scene-d) narrowed.
+struct Planned {
+    axes: GridAxes,
+    screen: Screen,
+    settings: KernelSettings,
+    skipped: usize,
+    notes: Vec<String>,
+}
+
+fn planned_grid(args: &KernelsArgs) -> Result<Planned> {
+    let mut axes = GridAxes::default();
+    if let Some(text) = &args.wavelengths_nm {
+        let wl = parse_list("wavelengths-nm", text)?;
+        axes.wavelengths_nm = wl.try_into().map_err(|_| {
+            Error::input("--wavelengths-nm: exactly three values (R,G,B) are required")
+        })?;
+    }
+    if let Some(text) = &args.objects {
+        axes.objects = parse_objects(text)?;
+    }
+    if let Some(text) = &args.focus_d {
+        axes.focus_d = parse_list("focus-d", text)?;
+    }
+    if let Some(text) = &args.pupils_mm {
+        axes.pupils_mm = parse_list("pupils-mm", text)?;
+    }
+    let screen = Screen {
+        fov_y_deg: args.fov_y,
+        height_px: args.height,
+    };
+    let settings = grid_settings(&axes, &screen, args.rmax_cap, args.energy)?;
+    let (mut skipped, mut notes) = (0, Vec::new());
+    if let Some(range) = &args.scene_d {
+        let narrowed = scene_grid(&axes, screen, parse_range("scene-d", range)?)?;
+        (axes, skipped, notes) = (narrowed.axes, narrowed.skipped_psfs, narrowed.notes);
+    }
+    Ok(Planned {
+        axes,
+        screen,
+        settings,
+        skipped,
+        notes,
+    })
+}
+
+/// `--field-deg auto`: the lattice the frame needs, and the outputs it writes (checked).
+fn auto_field(
+    args: &KernelsArgs,
+    eye: &Eye,
+    axes: &GridAxes,
+    screen: &Screen,
+) -> Result<(super::outputs::Outputs, FieldAxes)> {
+    let width = args
+        .width
+        .unwrap_or(((args.height as f64) * 16.0 / 9.0).round() as u32);
+    let plan = super::kernels_field::plan(eye, axes, screen, width)?;
+    for n in &plan.notes {
+        eprintln!("note: {n}");
+    }
+    eprintln!(
+        "field plan: {} × {} directions over ±{:.1}° × ±{:.1}°, interpolation error {:.4} µm \
+         (tolerance {} µm)",
+        plan.axes.h_deg.len(),
+        plan.axes.v_deg.len(),
+        plan.axes.h_deg.last().copied().unwrap_or(0.0),
+        plan.axes.v_deg.last().copied().unwrap_or(0.0),
+        plan.worst_error_um,
+        plan.tolerance_um
+    );
+    let mut fresh = super::outputs::Outputs::new();
+    super::kernels_field::register(&mut fresh, &args.output, &plan.axes)?;
+    fresh.probe()?;
+    Ok((fresh, plan.axes))
+}
+
+fn print_warnings(report: Option<&GridReport>, outcome: &CacheOutcome) {
+    if let Some(r) = report {
+        for w in &r.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    match outcome {
+        CacheOutcome::Stored {
+            warning: Some(w), ..
+        } => eprintln!("warning: {w}"),
+        CacheOutcome::WriteFailed(w) => eprintln!("warning: {w}"),
+        _ => {}
+    }
+}
+
+fn print_summary(summary: &Summary<'_>, grid: &crate::psf::kernels::KernelGrid) {
+    let source = match summary.cache {
+        CacheOutcome::Hit(p) => format!("loaded from cache {}", p.display()),
+        _ => format!("computed in {:.1} s", summary.seconds),
+    };
+    println!(
+        "{}: {} sets (pupils {:?} mm × focus {:?} D), {} objects {:.3}..{:.3} D, Rmax {} px, \
+         {:.1} MiB per set; {} PSFs ({} skipped), {source}",
+        summary.output,
+        summary.sets,
+        grid.pupils_mm,
+        grid.focus_d,
+        grid.objects.count,
+        grid.objects.min_d,
+        grid.objects.max_d(),
+        grid.max_radius_px,
+        summary.bytes_per_set as f64 / (1 << 20) as f64,
+        summary.psfs,
+        summary.psfs_skipped,
+    );
+    for n in summary.plan_notes {
+        println!("  plan: {n}");
+    }
+    let Some(r) = summary.report else { return };
+    for c in &r.columns {
+        println!(
+            "  pupil {:.2} mm, focus {:.3} D: lens {:.3} mm{}, residual R/G/B {:+.3} {:+.3} {:+.3} D, beta degree {:?}, PSFs by FFT {:?}, missed pupil energy {:.1e} {:.1e} {:.1e}",
+            c.pupil_mm,
+            c.focus_d,
+            c.lens_diameter_mm,
+            if c.beyond_far_point { " (beyond far point: relaxed)" } else { "" },
+            c.residual_d[0],
+            c.residual_d[1],
+            c.residual_d[2],
+            c.beta_degree,
+            c.fft_psfs,
+            c.missed_energy[0],
+            c.missed_energy[1],
+            c.missed_energy[2],
+        );
+    }
 }

@@ -223,7 +223,86 @@ struct Report {
 }
 
 pub fn run(args: &MetricsArgs) -> Result<()> {
-    let ppd = match (args.ppd, args.monitor) {
+    let ppd = viewing_ppd(args)?;
+    if let Some(path) = &args.map {
+        check_extension("--map", path, &["png"])?;
+        check_folder("--map", path)?;
+    }
+    let hdr = check_kinds(args)?;
+    let reference = load("REFERENCE", &args.reference)?;
+    let test = load("TEST", &args.test)?;
+    if (reference.width, reference.height) != (test.width, test.height) {
+        return Err(Error::input(format!(
+            "{} is {}×{} and {} is {}×{}: the images must have the same size",
+            args.reference.display(),
+            reference.width,
+            reference.height,
+            args.test.display(),
+            test.width,
+            test.height
+        )));
+    }
+    let (w, h) = (reference.width, reference.height);
+    let peak = if hdr {
+        hdr_peak(&reference.stored)
+    } else {
+        1.0
+    };
+    let (stored_ref, stored_test) = (view(&reference.stored, (w, h)), view(&test.stored, (w, h)));
+    let psnr_db = psnr(stored_ref, stored_test, peak);
+    let quality = ssim(stored_ref, stored_test, peak);
+    let settings = HdrSettings {
+        tone_mapper: args.tone_mapper.into(),
+        start: args.start_exposure,
+        stop: args.stop_exposure,
+        count: args.exposures,
+    };
+    let (linear_ref, linear_test) = (view(&reference.linear, (w, h)), view(&test.linear, (w, h)));
+    let (map, exposures) = if hdr {
+        let result = flip::hdr_flip(linear_ref, linear_test, ppd, &settings)
+            .map_err(|e| hdr_error(args, e))?;
+        (result.map, Some(result.range))
+    } else {
+        (flip::ldr_flip(linear_ref, linear_test, ppd), None)
+    };
+    let stats = FlipStats::of(&map);
+    let report = Report {
+        reference: args.reference.display().to_string(),
+        test: args.test.display().to_string(),
+        width: w,
+        height: h,
+        dynamic_range: reference.range,
+        ppd,
+        psnr_db,
+        psnr_peak: peak,
+        mssim: quality.mean,
+        ssim_window_px: quality.window_px,
+        flip: FlipReport {
+            metric: if hdr { "HDR-FLIP" } else { "LDR-FLIP" },
+            stats,
+            tone_mapper: hdr.then_some(settings.tone_mapper),
+            exposures,
+        },
+    };
+    if let Some(path) = &args.map {
+        write_map(path, &map, w, h)?;
+    }
+    if args.json {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
+        println!("{text}");
+    } else {
+        print_table(&report);
+        if let Some(path) = &args.map {
+            println!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// The viewing condition in pixels per degree: --ppd, else from --monitor, else FLIP's.
+fn viewing_ppd(args: &MetricsArgs) -> Result<f64> {
+    match (args.ppd, args.monitor) {
         (Some(p), _) => {
             if !ppd_in_range(p) {
                 return Err(Error::input(format!(
@@ -231,7 +310,7 @@ pub fn run(args: &MetricsArgs) -> Result<()> {
                     PPD_RANGE.0, PPD_RANGE.1
                 )));
             }
-            p
+            Ok(p)
         }
         (None, Some((width_m, res_x, dist_m))) => {
             let p = flip::pixels_per_degree(width_m, f64::from(res_x), dist_m);
@@ -242,14 +321,15 @@ pub fn run(args: &MetricsArgs) -> Result<()> {
                     PPD_RANGE.0, PPD_RANGE.1
                 )));
             }
-            p
+            Ok(p)
         }
-        (None, None) => flip::DEFAULT_PPD,
-    };
-    if let Some(path) = &args.map {
-        check_extension("--map", path, &["png"])?;
-        check_folder("--map", path)?;
+        (None, None) => Ok(flip::DEFAULT_PPD),
     }
+}
+
+/// Whether the images are HDR (both EXR) or LDR (neither); the HDR options are refused for
+/// LDR images and checked for range.
+fn check_kinds(args: &MetricsArgs) -> Result<bool> {
     let (ref_kind, test_kind) = (
         kind_of("REFERENCE", &args.reference)?,
         kind_of("TEST", &args.test)?,
@@ -285,112 +365,33 @@ pub fn run(args: &MetricsArgs) -> Result<()> {
             )));
         }
     }
-    let reference = load("REFERENCE", &args.reference)?;
-    let test = load("TEST", &args.test)?;
-    if (reference.width, reference.height) != (test.width, test.height) {
-        return Err(Error::input(format!(
-            "{} is {}×{} and {} is {}×{}: the images must have the same size",
-            args.reference.display(),
-            reference.width,
-            reference.height,
-            args.test.display(),
-            test.width,
-            test.height
-        )));
-    }
-    let (w, h) = (reference.width, reference.height);
-    let peak = if hdr {
-        let max = reference
-            .stored
-            .iter()
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .fold(0.0f32, f32::max);
-        if max > 0.0 {
-            f64::from(max)
-        } else {
-            1.0
-        }
+    Ok(hdr)
+}
+
+/// The PSNR peak of an HDR reference: its largest channel value (1 where it is black).
+fn hdr_peak(stored: &[[f32; 4]]) -> f64 {
+    let max = stored
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .fold(0.0f32, f32::max);
+    if max > 0.0 {
+        f64::from(max)
     } else {
         1.0
-    };
-    let psnr_db = psnr(
-        view(&reference.stored, (w, h)),
-        view(&test.stored, (w, h)),
-        peak,
-    );
-    let quality = ssim(
-        view(&reference.stored, (w, h)),
-        view(&test.stored, (w, h)),
-        peak,
-    );
-    let settings = HdrSettings {
-        tone_mapper: args.tone_mapper.into(),
-        start: args.start_exposure,
-        stop: args.stop_exposure,
-        count: args.exposures,
-    };
-    let (map, exposures) = if hdr {
-        let result = flip::hdr_flip(
-            view(&reference.linear, (w, h)),
-            view(&test.linear, (w, h)),
-            ppd,
-            &settings,
-        )
-        .map_err(|e| {
-            Error::input(match e {
-                flip::hdr::HdrError::NoAutomaticRange => format!(
-                    "{}: {e} (--start-exposure and --stop-exposure)",
-                    args.reference.display()
-                ),
-                flip::hdr::HdrError::BadRange(_) => {
-                    format!("--start-exposure / --stop-exposure / --exposures: {e}")
-                }
-            })
-        })?;
-        (result.map, Some(result.range))
-    } else {
-        (
-            flip::ldr_flip(
-                view(&reference.linear, (w, h)),
-                view(&test.linear, (w, h)),
-                ppd,
-            ),
-            None,
-        )
-    };
-    let stats = FlipStats::of(&map);
-    let report = Report {
-        reference: args.reference.display().to_string(),
-        test: args.test.display().to_string(),
-        width: w,
-        height: h,
-        dynamic_range: reference.range,
-        ppd,
-        psnr_db,
-        psnr_peak: peak,
-        mssim: quality.mean,
-        ssim_window_px: quality.window_px,
-        flip: FlipReport {
-            metric: if hdr { "HDR-FLIP" } else { "LDR-FLIP" },
-            stats,
-            tone_mapper: hdr.then_some(settings.tone_mapper),
-            exposures,
-        },
-    };
-    if let Some(path) = &args.map {
-        write_map(path, &map, w, h)?;
     }
-    if args.json {
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-        println!("{text}");
-    } else {
-        print_table(&report);
-        if let Some(path) = &args.map {
-            println!("wrote {}", path.display());
+}
+
+/// An HDR-FLIP error with the options that fix it named.
+fn hdr_error(args: &MetricsArgs, e: flip::hdr::HdrError) -> Error {
+    Error::input(match e {
+        flip::hdr::HdrError::NoAutomaticRange => format!(
+            "{}: {e} (--start-exposure and --stop-exposure)",
+            args.reference.display()
+        ),
+        flip::hdr::HdrError::BadRange(_) => {
+            format!("--start-exposure / --stop-exposure / --exposures: {e}")
         }
-    }
-    Ok(())
+    })
 }
 
 fn view(pixels: &[[f32; 4]], (w, h): (usize, usize)) -> ImageView<'_> {

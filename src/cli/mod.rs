@@ -7,9 +7,9 @@ use crate::Result;
 
 mod bench;
 mod compare;
+mod compare_files;
 pub(crate) mod correction;
 mod devices;
-mod edge_band;
 mod eye;
 mod eye_plot;
 mod kernels;
@@ -290,17 +290,26 @@ pub(crate) fn measured_scene_frame(
     crate::render::frame::EyeState,
     crate::psf::axes::Screen,
 )> {
+    use crate::render::frame_plan::{self, FrameView, PupilAsked, PupilFallback, SceneEye};
     let state = scene.at_time(0.0);
     let frame = crate::render::Rasterizer::new(ctx)?.render(ctx, &state, width, height)?;
-    let focus_d = if state.focus_m > 0.0 {
-        crate::render::focus::focus_d_of_distance_m(state.focus_m)
-    } else {
-        0.0
+    let view = FrameView {
+        width,
+        height,
+        fov_y_deg: state.camera.fov_y_deg,
+        color: &frame.color,
+        depth_m: &frame.depth_m,
     };
-    let pupil_mm = pupil_mm.or(state.pupil_mm).unwrap_or(5.0);
-    crate::limits::PUPIL_MM
-        .check("--pupil-mm", pupil_mm)
-        .map_err(crate::Error::input)?;
+    let scene_eye = SceneEye::of(&state);
+    let (focus_d, _) = frame_plan::focus_d(None, &scene_eye, &view)?;
+    let asked = PupilAsked {
+        given_mm: pupil_mm,
+        luminance_cdm2: None,
+        model: frame_plan::PupilModel::WatsonYellott,
+        age_years: 30.0,
+        fallback: PupilFallback::FixedMm(5.0),
+    };
+    let (pupil_mm, _) = frame_plan::pupil_mm(&asked, &scene_eye, &view)?;
     let screen = crate::psf::axes::Screen {
         fov_y_deg: state.camera.fov_y_deg,
         height_px: height,

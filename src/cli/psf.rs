@@ -145,19 +145,7 @@ pub fn run(args: &PsfArgs) -> Result<()> {
     }
     outputs.probe()?;
     let (set, source) = load_set(args)?;
-    let pupil_mm = positive("--pupil-mm", args.pupil_mm.unwrap_or(set.pupil_diameter_mm))?;
-    if pupil_mm > set.pupil_diameter_mm + 1e-9 {
-        return Err(Error::input(format!(
-            "--pupil-mm {pupil_mm} is larger than the {} mm pupil the coefficients were measured over; \
-             allowed: up to {} mm",
-            set.pupil_diameter_mm, set.pupil_diameter_mm
-        )));
-    }
-    let set = if pupil_mm < set.pupil_diameter_mm {
-        set.with_pupil(pupil_mm)?
-    } else {
-        set
-    };
+    let (set, pupil_mm) = over_pupil(set, args.pupil_mm)?;
     let wavelength_nm = args.wavelength_nm.unwrap_or(set.wavelength_nm);
     crate::limits::WAVELENGTH_NM
         .check("--wavelength-nm", wavelength_nm)
@@ -250,20 +238,40 @@ pub fn run(args: &PsfArgs) -> Result<()> {
     if args.json {
         println!("{text}");
     } else {
-        println!(
-            "wrote {} ({}×{}, {:.3} arcmin/px, Strehl {:.4}, β degree {}, truncation {:.1e}, {:.2} s) and {}",
-            args.output.display(),
-            args.size,
-            args.size,
-            pitch_arcmin,
-            psf.strehl,
-            psf.beta_degree,
-            psf.beta_truncation_error,
-            seconds,
-            sidecar_path(&args.output).display()
-        );
+        print_written(args, &sidecar);
     }
     Ok(())
+}
+
+/// The coefficients over `--pupil-mm` (default: their own pupil; never a larger one).
+fn over_pupil(set: ZernikeSet, pupil_mm: Option<f64>) -> Result<(ZernikeSet, f64)> {
+    let pupil_mm = positive("--pupil-mm", pupil_mm.unwrap_or(set.pupil_diameter_mm))?;
+    if pupil_mm > set.pupil_diameter_mm + 1e-9 {
+        return Err(Error::input(format!(
+            "--pupil-mm {pupil_mm} is larger than the {} mm pupil the coefficients were measured over; \
+             allowed: up to {} mm",
+            set.pupil_diameter_mm, set.pupil_diameter_mm
+        )));
+    }
+    if pupil_mm < set.pupil_diameter_mm {
+        return Ok((set.with_pupil(pupil_mm)?, pupil_mm));
+    }
+    Ok((set, pupil_mm))
+}
+
+fn print_written(args: &PsfArgs, sidecar: &Sidecar<'_>) {
+    println!(
+        "wrote {} ({}×{}, {:.3} arcmin/px, Strehl {:.4}, β degree {}, truncation {:.1e}, {:.2} s) and {}",
+        args.output.display(),
+        args.size,
+        args.size,
+        args.pitch_arcmin,
+        sidecar.strehl,
+        sidecar.beta_degree,
+        sidecar.beta_truncation_error,
+        sidecar.seconds,
+        sidecar_path(&args.output).display()
+    );
 }
 
 /// The optics core names its own quantities (`defocus_f`, `pitch_lambda_over_na`, the grid

@@ -4,29 +4,22 @@
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 
 use super::raster::{parse_size, TonemapArg};
 use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
 
-use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
 use crate::psf::axes::Screen;
 use crate::psf::cache::CacheOutcome;
 use crate::render::frame::{dioptre_range, scene_needs, EyeState, FrameRenderer, Method};
+pub use crate::render::frame_plan::PupilModel;
+use crate::render::frame_plan::{self, FocusAsked, FrameView, PupilAsked, PupilFallback, SceneEye};
 use crate::render::splat::FrameInput;
 use crate::render::Rasterizer;
 use crate::scene::Scene;
 use crate::{Error, Result};
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum PupilModel {
-    /// Watson & Yellott (2012) unified formula (field = the frame, one eye, --age).
-    WatsonYellott,
-    /// Moon & Spencer (1944), as Watson & Yellott quote it.
-    MoonSpencer,
-}
 
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
@@ -171,6 +164,119 @@ pub struct RenderArgs {
     /// Output image: .png (sRGB, tone-mapped) or .exr (linear).
     #[arg(short, long, value_name = "FILE", default_value = "ocular.png")]
     pub output: PathBuf,
+}
+
+/// The frame through its kernels (splat, reference or slices): a scene through splat stays on
+/// the GPU, drawn again in splat's own submission.
+fn render_frame(
+    args: &RenderArgs,
+    ctx: &Context,
+    input: &mut Input,
+    eye: Eye,
+    (needs, options): (
+        &crate::psf::plan::SceneNeeds,
+        &crate::render::frame::KernelOptions,
+    ),
+    splat: crate::render::splat::SplatSettings,
+    state: EyeState,
+) -> Result<(
+    crate::render::frame::RenderedFrame,
+    super::render_output::KernelInfo,
+)> {
+    let kernels = super::prepare_kernels(&eye, needs, options)?;
+    let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
+    let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
+    let missed = kernels
+        .report
+        .as_ref()
+        .map(|r| r.columns.iter().map(|c| c.missed_energy).collect());
+    let seconds_kernels = kernels.seconds;
+    let max_radius = kernels.grid.max_radius_px;
+    let field = kernels.field.as_ref().map(|f| f.plan.clone());
+    let mut renderer = FrameRenderer::new(ctx, eye, kernels, options.settings.clone(), splat);
+    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
+        .hidden
+        .iter()
+        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
+        .collect();
+    let frame_input = FrameInput {
+        width: input.width,
+        height: input.height,
+        color: &input.color,
+        depth_m: &input.depth_m,
+        fov_y_deg: input.fov_y_deg,
+        hidden_layers: if args.method == Method::Splat {
+            &hidden
+        } else {
+            &[]
+        },
+    };
+    let frame = match &mut input.raster {
+        // the frame stays on the GPU: drawn again in splat's submission, not uploaded
+        Some((rasterizer, scene, layers)) if args.method == Method::Splat => {
+            let scene_state = scene.at_time(args.time);
+            let size = (input.width, input.height);
+            let gap_d = args.splat.blend.settings().group_tolerance_d;
+            let mut recorded = rasterizer
+                .scene_frame(ctx, &scene_state, size)
+                .peeled(*layers, gap_d);
+            renderer.render_recorded(&mut recorded, state)?
+        }
+        _ => renderer.render(&frame_input, state, args.method)?,
+    };
+
+    let info = super::render_output::KernelInfo {
+        from_cache,
+        psfs,
+        missed,
+        seconds: seconds_kernels,
+        max_radius,
+        field,
+    };
+    Ok((frame, info))
+}
+
+/// The options checked on their own, before any file or device is opened; the splat
+/// settings they give.
+fn check_args(args: &RenderArgs) -> Result<crate::render::splat::SplatSettings> {
+    let output_ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if !matches!(output_ext.as_deref(), Some("png") | Some("exr")) {
+        return Err(Error::input(format!(
+            "-o {}: the output must end in .png or .exr",
+            args.output.display()
+        )));
+    }
+    let splat = args.splat.settings()?;
+    if let Some(fov) = args.fov_y {
+        check_fov(fov)?;
+    }
+    if args.method == Method::Views && args.color.is_some() {
+        return Err(Error::input(
+            "--method views rasterises a scene from points across the pupil; it cannot render \
+             a --color frame (one view): give a scene",
+        ));
+    }
+    if args.views.is_some() && args.method != Method::Views {
+        return Err(Error::input("--views applies to --method views"));
+    }
+    if args.layers.is_some() && args.method != Method::Splat {
+        return Err(Error::input(
+            "--layers applies to --method splat (reference and slices see the visible layer only)",
+        ));
+    }
+    check_file_options(args)?;
+    if let Some(ev) = args.exposure {
+        if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
+            return Err(Error::input(format!(
+                "--exposure {ev} must be a number of EV in [-64, 64]"
+            )));
+        }
+    }
+    Ok(splat)
 }
 
 /// Options that only mean something for file input are refused with a scene rather than
@@ -324,20 +430,10 @@ fn load_input(
     // methods; splat draws every layer again in its own submission (peeled there too).
     let frame = rasterizer.render(ctx, &state, width, height)?;
     let mut depth_m = frame.depth_m;
-    let near = crate::render::focus::nearest_supported_m();
-    let clamped = depth_m
-        .iter_mut()
-        .filter(|d| **d > 0.0 && **d < near)
-        .fold(0, |n, d| {
-            *d = near;
-            n + 1
-        });
-    if clamped > 0 {
-        warnings.push(format!(
-            "scene {name}: {}",
-            crate::inputs::depth::near_clamp_warning(clamped)
-        ));
-    }
+    warnings.extend(frame_plan::clamp_near_depth(
+        &mut depth_m,
+        &format!("scene {name}"),
+    ));
     let (fov_y_deg, focus_m) = (state.camera.fov_y_deg, state.focus_m);
     let (pupil_mm, luminance_cdm2) = (state.pupil_mm, state.luminance_cd_m2);
     Ok(Input {
@@ -360,172 +456,63 @@ fn load_input(
 
 /// The eye named by `--eye` (a preset or a file); errors name the option.
 pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
-    match crate::eye::file::resolve(spec) {
-        Ok(file) => Ok(file.eye),
-        Err(Error::Input(message)) => Err(Error::Input(format!("--eye: {message}"))),
-        Err(other) => Err(other),
-    }
+    frame_plan::load_eye("--eye", spec)
 }
 
-/// `--age`: a number of years within the range Watson & Yellott fitted (20 to 83).
-pub(crate) fn parse_age_years(text: &str) -> std::result::Result<f64, String> {
-    let age: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("{text:?} is not a number of years"))?;
-    if !(age.is_finite() && (20.0..=83.0).contains(&age)) {
-        return Err(format!(
-            "{age} years is outside 20 to 83, the ages the Watson–Yellott pupil formula covers"
-        ));
-    }
-    Ok(age)
-}
+pub(crate) use crate::render::frame_plan::parse_age_years;
 
-/// The focus vergence asked for (D) and the words naming where it came from, for messages.
-fn focus_dioptres(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
-    use crate::render::focus::{
-        focus_d_of_distance_m, normalised_focus_d, pixel_vergence_d, PixelOnScreen,
-    };
+/// The focus the options ask for; the rest of the decision is `frame_plan::focus_d`'s.
+fn focus_asked(args: &RenderArgs) -> Result<Option<FocusAsked>> {
     if let Some(text) = &args.focus_m {
         let t = text.trim().to_ascii_lowercase();
         if t == "inf" || t == "infinity" {
-            return Ok((0.0, "--focus-m".into()));
+            return Ok(Some(FocusAsked::DistanceM(f64::INFINITY)));
         }
         let m: f64 = t.parse().map_err(|_| {
             Error::input(format!(
                 "--focus-m \"{text}\" is not a distance in metres or inf"
             ))
         })?;
-        if m.is_nan() || m <= 0.0 {
-            return Err(Error::input(format!(
-                "--focus-m {m} must be a positive distance in metres (or inf)"
-            )));
-        }
-        return Ok((focus_d_of_distance_m(m), "--focus-m".into()));
+        return Ok(Some(FocusAsked::DistanceM(m)));
     }
-    if let Some(d) = args.focus_d {
-        if !(d.is_finite() && d >= 0.0) {
-            return Err(Error::input(format!(
-                "--focus-d {d} must be a non-negative vergence in dioptres"
-            )));
-        }
-        return Ok((normalised_focus_d(d), "--focus-d".into()));
-    }
-    let vergence_at = |x: u32, y: u32| {
-        let depth_m = input.depth_m[(y * input.width + x) as usize];
-        let at = PixelOnScreen {
-            x,
-            y,
-            width: input.width,
-            height: input.height,
-            fov_y_deg: input.fov_y_deg,
-        };
-        normalised_focus_d(pixel_vergence_d(depth_m, at))
-    };
-    if let Some((x, y)) = args.focus_at {
-        if x >= input.width || y >= input.height {
-            return Err(Error::input(format!(
-                "--focus-at {x},{y} is outside the {}×{} frame",
-                input.width, input.height
-            )));
-        }
-        return Ok((vergence_at(x, y), format!("--focus-at {x},{y}")));
-    }
-    if let Some(m) = input.focus_m {
-        let d = if m > 0.0 {
-            focus_d_of_distance_m(m)
-        } else {
-            0.0
-        };
-        return Ok((d, "the scene's focus".into()));
-    }
-    let (x, y) = (input.width / 2, input.height / 2);
-    Ok((
-        vergence_at(x, y),
-        format!("the default focus (depth at the frame centre {x},{y}; or use --focus-m)"),
-    ))
+    Ok(args
+        .focus_d
+        .map(FocusAsked::Dioptres)
+        .or(args.focus_at.map(|(x, y)| FocusAsked::AtPixel(x, y))))
 }
 
-/// Mean luminance (cd/m²) of linear Rec.709 RGB.
-fn mean_luminance(color: &[[f32; 4]]) -> f64 {
-    let sum: f64 = color
-        .iter()
-        .map(|p| f64::from(crate::image_io::luminance([p[0], p[1], p[2]])))
-        .sum();
-    sum / color.len().max(1) as f64
+fn pupil_asked(args: &RenderArgs) -> PupilAsked<'static> {
+    PupilAsked {
+        given_mm: args.pupil_mm,
+        luminance_cdm2: args.luminance_cdm2.map(|l| (l, "--luminance-cdm2")),
+        model: args.pupil_model,
+        age_years: args.age,
+        fallback: PupilFallback::Luminance,
+    }
 }
 
-fn pupil_diameter(args: &RenderArgs, input: &Input) -> Result<(f64, String)> {
-    if let Some(p) = args.pupil_mm {
-        crate::limits::PUPIL_MM
-            .check("--pupil-mm", p)
-            .map_err(Error::input)?;
-        return Ok((p, "given".into()));
+impl Input {
+    fn view(&self) -> FrameView<'_> {
+        FrameView {
+            width: self.width,
+            height: self.height,
+            fov_y_deg: self.fov_y_deg,
+            color: &self.color,
+            depth_m: &self.depth_m,
+        }
     }
-    let (luminance, source) = if let Some(l) = args.luminance_cdm2 {
-        (l, "--luminance-cdm2")
-    } else if let Some(p) = input.pupil_mm {
-        return Ok((p, "scene".into()));
-    } else if let Some(l) = input.luminance_cdm2 {
-        (l, "scene luminance")
-    } else {
-        (mean_luminance(&input.color), "frame mean luminance")
-    };
-    if !(luminance.is_finite() && luminance >= 0.0) {
-        return Err(Error::input(format!(
-            "luminance {luminance} cd/m² must be a non-negative number"
-        )));
+
+    fn scene_eye(&self) -> SceneEye {
+        SceneEye {
+            focus_m: self.focus_m,
+            pupil_mm: self.pupil_mm,
+            luminance_cdm2: self.luminance_cdm2,
+        }
     }
-    let aspect = f64::from(input.width) / f64::from(input.height);
-    let field_deg2 = input.fov_y_deg * input.fov_y_deg * aspect;
-    let (mm, model) = match args.pupil_model {
-        PupilModel::WatsonYellott => (
-            watson_yellott_mm(luminance, field_deg2, args.age, Viewing::OneEye),
-            "Watson–Yellott",
-        ),
-        PupilModel::MoonSpencer => (moon_spencer_mm(luminance), "Moon–Spencer"),
-    };
-    Ok((mm, format!("{model} at {luminance:.3} cd/m² ({source})")))
 }
 
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
-    let output_ext = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if !matches!(output_ext.as_deref(), Some("png") | Some("exr")) {
-        return Err(Error::input(format!(
-            "-o {}: the output must end in .png or .exr",
-            args.output.display()
-        )));
-    }
-    let splat = args.splat.settings()?;
-    if let Some(fov) = args.fov_y {
-        check_fov(fov)?;
-    }
-    if args.method == Method::Views && args.color.is_some() {
-        return Err(Error::input(
-            "--method views rasterises a scene from points across the pupil; it cannot render \
-             a --color frame (one view): give a scene",
-        ));
-    }
-    if args.views.is_some() && args.method != Method::Views {
-        return Err(Error::input("--views applies to --method views"));
-    }
-    if args.layers.is_some() && args.method != Method::Splat {
-        return Err(Error::input(
-            "--layers applies to --method splat (reference and slices see the visible layer only)",
-        ));
-    }
-    check_file_options(args)?;
-    if let Some(ev) = args.exposure {
-        if !(ev.is_finite() && (-64.0..=64.0).contains(&ev)) {
-            return Err(Error::input(format!(
-                "--exposure {ev} must be a number of EV in [-64, 64]"
-            )));
-        }
-    }
+    let splat = check_args(args)?;
     let (eye, physiology) = args.correction.apply(
         &load_eye(&args.eye)?,
         Some((args.age, args.accommodation_line)),
@@ -535,16 +522,10 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     for w in &input.warnings {
         eprintln!("warning: {w}");
     }
-    let (focus_d, focus_from) = focus_dioptres(args, &input)?;
-    if focus_d > crate::render::focus::MAX_OBJECT_VERGENCE_D {
-        return Err(Error::input(format!(
-            "{focus_from}: a focus at {:.4} m ({focus_d:.1} D) is nearer than ocular renders \
-             (at most {} D, 2 cm)",
-            1.0 / focus_d,
-            crate::render::focus::MAX_OBJECT_VERGENCE_D
-        )));
-    }
-    let (pupil_mm, pupil_source) = pupil_diameter(args, &input)?;
+    let (focus_d, focus_from) =
+        frame_plan::focus_d(focus_asked(args)?, &input.scene_eye(), &input.view())?;
+    let (pupil_mm, pupil_source) =
+        frame_plan::pupil_mm(&pupil_asked(args), &input.scene_eye(), &input.view())?;
     let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
     if args.splat.off_axis {
         if matches!(args.method, Method::Slices | Method::Views) {
@@ -598,56 +579,15 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             None,
         );
     }
-    let kernels = super::prepare_kernels(&eye, &needs, &options)?;
-    let from_cache = matches!(kernels.cache, CacheOutcome::Hit(_));
-    let psfs = kernels.report.as_ref().map_or(0, |r| r.psfs_computed);
-    let missed = kernels
-        .report
-        .as_ref()
-        .map(|r| r.columns.iter().map(|c| c.missed_energy).collect());
-    let seconds_kernels = kernels.seconds;
-    let max_radius = kernels.grid.max_radius_px;
-    let field = kernels.field.as_ref().map(|f| f.plan.clone());
-    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
-    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
-        .hidden
-        .iter()
-        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
-        .collect();
-    let frame_input = FrameInput {
-        width: input.width,
-        height: input.height,
-        color: &input.color,
-        depth_m: &input.depth_m,
-        fov_y_deg: input.fov_y_deg,
-        hidden_layers: if args.method == Method::Splat {
-            &hidden
-        } else {
-            &[]
-        },
-    };
-    let frame = match &mut input.raster {
-        // the frame stays on the GPU: drawn again in splat's submission, not uploaded
-        Some((rasterizer, scene, layers)) if args.method == Method::Splat => {
-            let scene_state = scene.at_time(args.time);
-            let size = (input.width, input.height);
-            let gap_d = args.splat.blend.settings().group_tolerance_d;
-            let mut recorded = rasterizer
-                .scene_frame(&ctx, &scene_state, size)
-                .peeled(*layers, gap_d);
-            renderer.render_recorded(&mut recorded, state)?
-        }
-        _ => renderer.render(&frame_input, state, args.method)?,
-    };
-
-    let info = super::render_output::KernelInfo {
-        from_cache,
-        psfs,
-        missed,
-        seconds: seconds_kernels,
-        max_radius,
-        field,
-    };
+    let (frame, info) = render_frame(
+        args,
+        &ctx,
+        &mut input,
+        eye,
+        (&needs, &options),
+        splat,
+        state,
+    )?;
     super::render_output::finish(
         args,
         &ctx,

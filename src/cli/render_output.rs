@@ -94,24 +94,7 @@ pub(super) fn finish(
         ),
         None => (false, 0, None, 0.0, 0, None),
     };
-    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
-    if output_ext.as_deref() == Some("exr") {
-        image_io::write_exr_rgba(&args.output, &image)?;
-    } else {
-        let mode = match args.tonemap {
-            TonemapArg::Clamp => TonemapMode::Clamp,
-            TonemapArg::Reinhard => TonemapMode::Reinhard,
-        };
-        // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
-        let exposure_ev = args.exposure.unwrap_or_else(|| {
-            Tonemap::auto_exposure_ev(&ImageRgba::new(
-                input.width,
-                input.height,
-                input.color.clone(),
-            ))
-        });
-        image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })?;
-    }
+    write_image(args, input, &frame, output_ext.as_deref())?;
     let gpu: Option<Vec<(String, f64)>> = frame
         .timings
         .as_ref()
@@ -154,6 +137,38 @@ pub(super) fn finish(
         );
         return Ok(());
     }
+    print_summary(args, input, &summary, &frame);
+    Ok(())
+}
+
+/// The image: linear EXR, or PNG at the input frame's exposure (or --exposure).
+fn write_image(
+    args: &RenderArgs,
+    input: &Input,
+    frame: &crate::render::frame::RenderedFrame,
+    output_ext: Option<&str>,
+) -> Result<()> {
+    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
+    if output_ext == Some("exr") {
+        return image_io::write_exr_rgba(&args.output, &image);
+    }
+    let mode = match args.tonemap {
+        TonemapArg::Clamp => TonemapMode::Clamp,
+        TonemapArg::Reinhard => TonemapMode::Reinhard,
+    };
+    // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
+    let exposure_ev = args.exposure.unwrap_or_else(|| {
+        Tonemap::auto_exposure_ev(&ImageRgba::new(
+            input.width,
+            input.height,
+            input.color.clone(),
+        ))
+    });
+    image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })
+}
+
+/// Where the eye focused, in words: the distance, and the limit it met.
+fn focus_words(summary: &Summary) -> String {
     let distance = |d: f64| {
         if d > 0.0 {
             format!("{:.3} m", 1.0 / d)
@@ -161,17 +176,18 @@ pub(super) fn finish(
             "infinity".into()
         }
     };
-    let focus = match focus.limit {
-        crate::eye::FocusLimit::Reached => distance(focus_d),
+    let (asked, reached) = (summary.focus_d, summary.focus_reached_d);
+    let focus = match summary.focus_limit {
+        crate::eye::FocusLimit::Reached => distance(asked),
         crate::eye::FocusLimit::FarPoint => format!(
             "{} (its far point; asked {}, beyond it)",
-            distance(focus.actual_d),
-            distance(focus_d)
+            distance(reached),
+            distance(asked)
         ),
         crate::eye::FocusLimit::NearPoint => format!(
             "{} (its near point, clamped; asked {}, nearer)",
-            distance(focus.actual_d),
-            distance(focus_d)
+            distance(reached),
+            distance(asked)
         ),
     };
     let through = summary
@@ -180,7 +196,16 @@ pub(super) fn finish(
         .as_ref()
         .map(|c| format!(" through {c}"))
         .unwrap_or_default();
-    let focus = format!("{focus}{through}");
+    format!("{focus}{through}")
+}
+
+fn print_summary(
+    args: &RenderArgs,
+    input: &Input,
+    summary: &Summary,
+    frame: &crate::render::frame::RenderedFrame,
+) {
+    let focus = focus_words(summary);
     println!(
         "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
         summary.output,
@@ -188,16 +213,19 @@ pub(super) fn finish(
         input.height,
         input.label,
         args.eye,
-        pupil_mm,
+        summary.pupil_mm,
         summary.pupil_source,
         args.method.name(),
         frame.seconds,
         if args.method == Method::Views {
             "none".to_string()
-        } else if from_cache {
+        } else if summary.kernels_from_cache {
             "from cache".to_string()
         } else {
-            format!("{psfs} PSFs in {seconds_kernels:.1} s")
+            format!(
+                "{} PSFs in {:.1} s",
+                summary.psfs_computed, summary.seconds_kernels
+            )
         }
     );
     if let Some(f) = &summary.field {
@@ -212,20 +240,20 @@ pub(super) fn finish(
             f.worst_error_um
         );
     }
-    if args.timings {
-        if let Some(t) = &frame.timings {
-            for p in &t.passes {
-                println!("  {:<12} {:>9.3} ms", p.name, p.ms);
-            }
-            println!(
-                "  {:<12} {:>9.3} ms  (GPU, {})",
-                "total",
-                t.total_ms(),
-                summary.device
-            );
-        } else {
-            println!("  (--timings applies to --method splat)");
-        }
+    if !args.timings {
+        return;
     }
-    Ok(())
+    if let Some(t) = &frame.timings {
+        for p in &t.passes {
+            println!("  {:<12} {:>9.3} ms", p.name, p.ms);
+        }
+        println!(
+            "  {:<12} {:>9.3} ms  (GPU, {})",
+            "total",
+            t.total_ms(),
+            summary.device
+        );
+    } else {
+        println!("  (--timings applies to --method splat)");
+    }
 }

@@ -4,9 +4,9 @@
 
 use super::video::VideoArgs;
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba};
-use crate::optics::pupil::{watson_yellott_mm, Viewing};
+use crate::image_io::ImageRgba;
 use crate::render::frame::{EyeState, FrameRenderer, Method};
+use crate::render::frame_plan::{self, FrameView, PupilAsked, PupilFallback, PupilModel, SceneEye};
 use crate::render::splat::FrameInput;
 use crate::render::{Frame, Rasterizer};
 use crate::scene::FrameState;
@@ -14,44 +14,40 @@ use crate::Result;
 
 const IDENTITY: [[f64; 2]; 2] = [[1.0, 0.0], [0.0, 1.0]];
 
-/// Whether the pupil follows the frame's own mean luminance (neither `--pupil-mm` nor the
-/// scene gives a pupil or an adapting luminance).
+/// The pupil options of a video frame: Watson–Yellott at the scene's luminance, else at the
+/// frame's mean luminance, where neither `--pupil-mm` nor the scene gives a pupil.
+pub(super) fn pupil_asked(args: &VideoArgs) -> PupilAsked<'static> {
+    PupilAsked {
+        given_mm: args.pupil_mm,
+        luminance_cdm2: None,
+        model: PupilModel::WatsonYellott,
+        age_years: args.age,
+        fallback: PupilFallback::Luminance,
+    }
+}
+
+/// Whether the pupil follows the frame's own mean luminance.
 fn pupil_needs_frame(args: &VideoArgs, state: &FrameState<'_>) -> bool {
-    args.pupil_mm.or(state.pupil_mm).is_none() && state.luminance_cd_m2.is_none()
+    frame_plan::pupil_needs_frame(&pupil_asked(args), &SceneEye::of(state))
 }
 
 /// The pupil for `state` over a `width`×`height` field of `fov_y_deg`; `frame` is read only
-/// where [`pupil_needs_frame`] (and is then required).
+/// where [`pupil_needs_frame`].
 pub(super) fn pupil_for(
     args: &VideoArgs,
     state: &FrameState<'_>,
     frame: Option<&Frame>,
     (width, height): (u32, u32),
     fov_y_deg: f64,
-) -> f64 {
-    if let Some(p) = args.pupil_mm.or(state.pupil_mm) {
-        return p;
-    }
-    let frame_luminance = |frame: &Frame| {
-        let sum: f64 = frame
-            .color
-            .iter()
-            .map(|p| f64::from(image_io::luminance([p[0], p[1], p[2]])))
-            .sum();
-        sum / frame.color.len().max(1) as f64
+) -> Result<f64> {
+    let view = FrameView {
+        width,
+        height,
+        fov_y_deg,
+        color: frame.map_or(&[][..], |f| &f.color),
+        depth_m: &[],
     };
-    let luminance = state
-        .luminance_cd_m2
-        .or(frame.map(frame_luminance))
-        .expect("callers read the frame back where the pupil follows its luminance");
-    let aspect = f64::from(width) / f64::from(height);
-    watson_yellott_mm(
-        luminance,
-        fov_y_deg * fov_y_deg * aspect,
-        args.age,
-        Viewing::OneEye,
-    )
-    .clamp(1.5, 8.0)
+    Ok(frame_plan::pupil_mm(&pupil_asked(args), &SceneEye::of(state), &view)?.0)
 }
 
 /// One splatted panel of `state`'s frame per renderer, each seen through its spectacle's
@@ -79,7 +75,7 @@ pub(super) fn render_panels(
     };
     let eye_state = EyeState {
         focus_d,
-        pupil_mm: pupil_for(args, state, measured.as_ref(), size, fov_y_deg),
+        pupil_mm: pupil_for(args, state, measured.as_ref(), size, fov_y_deg)?,
     };
     let mut panels = Vec::new();
     for (renderer, magnification) in renderers.iter_mut().zip(magnifications) {

@@ -25,3 +25,4 @@ pub mod kernels;
 pub mod plan;
 pub mod preview;
 pub mod project;
+pub mod request;

@@ -1,10 +1,13 @@
 //! One frame's options from Python, checked with the CLI's messages, and the focus, pupil and
 //! accommodation resolved from them and the frame as `ocular render` resolves them.
 
-use crate::cli::correction::{CorrectionArgs, Physiology};
 use crate::eye::age::HofstetterLine;
 use crate::eye::Eye;
 use crate::render::frame::Method;
+use crate::render::frame_plan::{
+    self, Correction, FocusAsked, FrameView, Physiology, PupilAsked, PupilFallback, PupilModel,
+    SceneEye,
+};
 use crate::{Error, Result};
 
 use super::eye::check_pupil;
@@ -85,7 +88,7 @@ pub(super) fn options(
             )));
         }
     }
-    crate::cli::render::parse_age_years(&age.to_string())
+    frame_plan::parse_age_years(&age.to_string())
         .map_err(|e| Error::input(format!("--age: {e}")))?;
     let method = parse_method(method)?;
     let most = crate::inputs::layered::MAX_LAYERS as u32;
@@ -118,93 +121,56 @@ pub(super) fn options(
     })
 }
 
-/// The focus vergence asked for and the words naming its source, as `ocular render` decides.
+impl HostFrame {
+    fn view(&self) -> FrameView<'_> {
+        FrameView {
+            width: self.width,
+            height: self.height,
+            fov_y_deg: self.fov_y_deg,
+            color: &self.color,
+            depth_m: &self.depth_m,
+        }
+    }
+
+    fn scene_eye(&self) -> SceneEye {
+        SceneEye {
+            focus_m: self.scene_focus_m,
+            pupil_mm: self.scene_pupil_mm,
+            luminance_cdm2: self.scene_luminance_cdm2,
+        }
+    }
+}
+
+/// The focus vergence and the words naming its source, as `ocular render` decides (a focus
+/// nearer than ocular renders is refused).
 pub(super) fn focus_dioptres(o: &Options, f: &HostFrame) -> Result<(f64, String)> {
-    use crate::render::focus::{
-        focus_d_of_distance_m, normalised_focus_d, pixel_vergence_d, PixelOnScreen,
-    };
-    if let Some(m) = o.focus_m {
-        if m.is_nan() || m <= 0.0 {
-            return Err(Error::input(format!(
-                "--focus-m {m} must be a positive distance in metres (or inf)"
-            )));
-        }
-        return Ok((focus_d_of_distance_m(m), "--focus-m".into()));
-    }
-    if let Some(d) = o.focus_d {
-        if !(d.is_finite() && d >= 0.0) {
-            return Err(Error::input(format!(
-                "--focus-d {d} must be a non-negative vergence in dioptres"
-            )));
-        }
-        return Ok((normalised_focus_d(d), "--focus-d".into()));
-    }
-    let vergence_at = |x: u32, y: u32| {
-        let at = PixelOnScreen {
-            x,
-            y,
-            width: f.width,
-            height: f.height,
-            fov_y_deg: f.fov_y_deg,
-        };
-        normalised_focus_d(pixel_vergence_d(f.depth_m[(y * f.width + x) as usize], at))
-    };
-    if let Some((x, y)) = o.focus_at {
-        if x >= f.width || y >= f.height {
-            return Err(Error::input(format!(
-                "--focus-at {x},{y} is outside the {}×{} frame",
-                f.width, f.height
-            )));
-        }
-        return Ok((vergence_at(x, y), format!("--focus-at {x},{y}")));
-    }
-    if let Some(m) = f.scene_focus_m {
-        let d = if m > 0.0 {
-            focus_d_of_distance_m(m)
-        } else {
-            0.0
-        };
-        return Ok((d, "the scene's focus".into()));
-    }
-    let (x, y) = (f.width / 2, f.height / 2);
-    Ok((
-        vergence_at(x, y),
-        format!("the default focus (depth at the frame centre {x},{y}; or use --focus-m)"),
-    ))
+    let asked = o
+        .focus_m
+        .map(FocusAsked::DistanceM)
+        .or(o.focus_d.map(FocusAsked::Dioptres))
+        .or(o.focus_at.map(|(x, y)| FocusAsked::AtPixel(x, y)));
+    frame_plan::focus_d(asked, &f.scene_eye(), &f.view())
 }
 
 /// The pupil as `ocular render` picks it: given, else Watson–Yellott at the luminance given,
 /// the scene's pupil or luminance, or the frame's mean luminance.
-pub(super) fn pupil_diameter(o: &Options, f: &HostFrame) -> (f64, String) {
-    use crate::optics::pupil::{watson_yellott_mm, Viewing};
-    if let Some(p) = o.pupil_mm {
-        return (p, "given".into());
-    }
-    let (luminance, source) = if let Some(l) = o.luminance_cdm2 {
-        (l, "luminance_cdm2")
-    } else if let Some(p) = f.scene_pupil_mm {
-        return (p, "scene".into());
-    } else if let Some(l) = f.scene_luminance_cdm2 {
-        (l, "scene luminance")
-    } else {
-        let sum: f64 = f
-            .color
-            .iter()
-            .map(|p| f64::from(crate::image_io::luminance([p[0], p[1], p[2]])))
-            .sum();
-        (sum / f.color.len().max(1) as f64, "frame mean luminance")
+pub(super) fn pupil_diameter(o: &Options, f: &HostFrame) -> Result<(f64, String)> {
+    let asked = PupilAsked {
+        given_mm: o.pupil_mm,
+        luminance_cdm2: o.luminance_cdm2.map(|l| (l, "luminance_cdm2")),
+        model: PupilModel::WatsonYellott,
+        age_years: o.age,
+        fallback: PupilFallback::Luminance,
     };
-    let aspect = f64::from(f.width) / f64::from(f.height);
-    let field_deg2 = f.fov_y_deg * f.fov_y_deg * aspect;
-    let mm = watson_yellott_mm(luminance, field_deg2, o.age, Viewing::OneEye);
-    (
-        mm,
-        format!("Watson–Yellott at {luminance:.3} cd/m² ({source})"),
-    )
+    frame_plan::pupil_mm(&asked, &f.scene_eye(), &f.view())
 }
 
 /// The eye as the CLI renders it: with the age's amplitude of accommodation unless its file
 /// sets one (a correction the eye carries stays).
 pub(super) fn physiology(eye: &Eye, age: f64) -> Result<(Eye, Physiology)> {
-    CorrectionArgs::default().apply(eye, Some((age, HofstetterLine::Mean)))
+    frame_plan::corrected_eye(
+        eye,
+        &Correction::default(),
+        Some((age, HofstetterLine::Mean)),
+    )
 }

@@ -113,15 +113,7 @@ impl PyRenderer {
     ) -> Result<Vec<[f32; 4]>> {
         let (eye, physiology) = physiology(eye, o.age)?;
         let (focus_d, focus_from) = focus_dioptres(o, frame)?;
-        if focus_d > crate::render::focus::MAX_OBJECT_VERGENCE_D {
-            return Err(Error::input(format!(
-                "{focus_from}: a focus at {:.4} m ({focus_d:.1} D) is nearer than ocular renders \
-                 (at most {} D, 2 cm)",
-                1.0 / focus_d,
-                crate::render::focus::MAX_OBJECT_VERGENCE_D
-            )));
-        }
-        let (pupil_mm, pupil_from) = pupil_diameter(o, frame);
+        let (pupil_mm, pupil_from) = pupil_diameter(o, frame)?;
         let options = self.kernel_options(o, frame.width);
         let state = EyeState { focus_d, pupil_mm };
         let key = Key {
@@ -242,7 +234,7 @@ impl PyRenderer {
             }
         }
         let magnification = match eye {
-            Some(e) => crate::cli::correction::spectacle_magnification(e)?,
+            Some(e) => crate::render::frame_plan::spectacle_magnification(e)?,
             None => None,
         };
         let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
@@ -273,21 +265,10 @@ impl PyRenderer {
         let (width, height) = size_px;
         let drawn = raster.render(&self.ctx, &state, width, height)?;
         let mut depth_m = drawn.depth_m;
-        let near = crate::render::focus::nearest_supported_m();
-        let clamped = depth_m
-            .iter_mut()
-            .filter(|d| **d > 0.0 && **d < near)
-            .fold(0, |n, d| {
-                *d = near;
-                n + 1
-            });
-        let mut warnings = Vec::new();
-        if clamped > 0 {
-            warnings.push(format!(
-                "scene {name}: {}",
-                crate::inputs::depth::near_clamp_warning(clamped)
-            ));
-        }
+        let warnings: Vec<String> =
+            crate::render::frame_plan::clamp_near_depth(&mut depth_m, &format!("scene {name}"))
+                .into_iter()
+                .collect();
         let frame = HostFrame {
             width,
             height,
