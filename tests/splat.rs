@@ -9,7 +9,8 @@ use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::gpu::texture_probe::TextureProbe;
 use ocular::gpu::Context;
 use ocular::psf::kernels::{
-    kernel_side, level_block_radius, level_count, level_of_radius, DioptreAxis, KernelGrid,
+    kernel_side, level_block_radius, level_count, level_of_radius, level_radius_px, DioptreAxis,
+    KernelGrid,
 };
 use ocular::render::reference;
 use ocular::render::splat::{
@@ -213,6 +214,105 @@ fn psf_texture_matches_cpu_blend_of_four_grid_states() {
         assert!(worst < tolerance, "{format:?}: {worst}");
         drop((splatter, probe));
     }
+    common::finish(ctx);
+}
+
+/// A merged block of 4×4 pixels and up reads its level's kernel summed over the block's
+/// pixels: every such texel the atlas holds equals the sum, written here from the blended
+/// kernel texel by texel (the block's pixels at ±½ … ±(s − 1)/2 from its centre), divided by
+/// s² and stored at the level's (2r+1)² scale, with its ring of zeros.
+#[test]
+fn block_kernels_are_the_kernel_summed_over_the_block() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.3, 4.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 5);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let view = ViewState {
+        pupil_mm: 4.0,
+        focus_d: 0.3,
+    };
+    let expected = grid.blended_set(view.pupil_mm, view.focus_d);
+    let settings = SplatSettings {
+        texture_format: PsfTextureFormat::Rgba32Float,
+        merge: MergeSettings {
+            levels: 4,
+            blur_per_block: 0.0,
+            min_radius_px: 2.0,
+            ..MergeSettings::default()
+        },
+        ..SplatSettings::default()
+    };
+    let mut splatter = Splatter::new(&ctx, grid.clone(), settings).unwrap();
+    splatter
+        .render(
+            &Scene::new(16, 16, |_, _| ([0.5; 3], 2.0)).input(),
+            view,
+            false,
+        )
+        .unwrap();
+    let (image, sampler) = splatter.psf_texture();
+    let (mut points, mut wanted) = (Vec::new(), Vec::new());
+    let mut held = 0;
+    for side in [4i64, 8, 16] {
+        for level in 0..level_count(max_radius) {
+            let Some([cx, cy]) = splatter.psf_texture_block_centre(0, level, side as u32) else {
+                assert!(
+                    level_radius_px(level) < 2.0,
+                    "level {level} of side {side} missing"
+                );
+                continue;
+            };
+            held += 1;
+            let r = level_block_radius(level) as i64;
+            let k = kernel_side(r as u32);
+            let edge = r + side / 2; // texels on either side of the centre
+            for o in [0, objects.count - 1] {
+                let kernel = expected.kernel(level, o);
+                for ty in -edge - 1..=edge {
+                    for tx in -edge - 1..=edge {
+                        // texel (cx + tx) holds offset tx + ½ from the block's centre
+                        let mut sum = [0.0f64; 3];
+                        for jy in 0..side {
+                            for jx in 0..side {
+                                // pixel j at j − (s − 1)/2: integer kernel offset t − j + s/2
+                                let (kx, ky) = (tx - jx + side / 2, ty - jy + side / 2);
+                                if kx.abs() <= r && ky.abs() <= r {
+                                    let v = kernel[((ky + r) * k as i64 + kx + r) as usize];
+                                    for c in 0..3 {
+                                        sum[c] += f64::from(v[c]);
+                                    }
+                                }
+                            }
+                        }
+                        let scale = (k * k) as f64 / (side * side) as f64;
+                        let ring = tx == -edge - 1 || ty == -edge - 1 || tx == edge || ty == edge;
+                        points.push([
+                            (cx as i64 + tx) as f32 + 0.5,
+                            (cy as i64 + ty) as f32 + 0.5,
+                            o as f32 + 0.5,
+                        ]);
+                        wanted.push(if ring {
+                            [0.0; 3]
+                        } else {
+                            sum.map(|v| (v * scale) as f32)
+                        });
+                    }
+                }
+            }
+        }
+    }
+    assert!(held >= 3 * 4, "{held} block kernels held");
+    let probe = TextureProbe::new(&ctx).unwrap();
+    let samples = probe.sample(&ctx, image, sampler, &points).unwrap();
+    let mut worst = 0.0f32;
+    for (want, s) in wanted.iter().zip(&samples) {
+        for c in 0..3 {
+            worst = worst.max((want[c] - s[c]).abs() / want[c].abs().max(1.0));
+        }
+    }
+    eprintln!("{held} block kernels: worst relative texel error {worst:.2e}");
+    assert!(worst < 1e-5, "{worst}");
+    drop((splatter, probe));
     common::finish(ctx);
 }
 
@@ -506,6 +606,7 @@ fn every_pass_matches_its_cpu_step() {
         dioptre_step: objects.step_d as f32,
         max_radius,
         focal_px: (32.0 / 30f64.to_radians().tan()) as f32,
+        group_tolerance_d: settings.blend.group_tolerance_d,
     };
     let mut cpu = splat_cpu::fragments(&frame, &scene.color, &scene.depth, &grid.sets[0].radius_px);
     let core: Vec<f32> = grid.sets[0]

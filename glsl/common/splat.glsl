@@ -180,24 +180,31 @@ vec3 pupil_share(uint size, vec3 radius, float inner, vec2 d) {
 
 // How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.
 // Kernels of radius r occupy (2r+1)² texels centred on the fragment; a merged fragment sits
-// half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further. Off
-// the centre of a wide frame a kernel stretches by up to 1/cos²θ and is read bilinearly
-// between texels, so it reaches up to (r + 1)/cos²θ, exclusive.
+// half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further, and a
+// block of side s ≥ 4 reads its block-summed kernel of (2r+s)² texels. Off the centre of a
+// wide frame a kernel stretches by up to 1/cos²θ and is read bilinearly between texels, so it
+// reaches up to (r + 1)/cos²θ, exclusive.
 float fragment_reach(Fragment f) {
     float radius = max(f.radius.r, max(f.radius.g, f.radius.b));
     float r = ceil(radius);
     vec3 s = local_scale(f.center);
     vec2 c = shrink_for_radius(s.z, radius);
-    if (c.x < 1.0) {
-        // Bilinear reads reach one texel past the block: the kernel is non-zero for kernel
-        // offsets inside the square of half-side r + 1. Screen offsets are its image under the
-        // inverse map (1/c_t)·I + (1/c_r − 1/c_t)·e·eᵀ, whose extent along a grid axis is the
-        // largest row sum of its absolute values.
-        float a = 1.0 / c.x - 1.0 / c.y;
-        float along = max(s.x * s.x, s.y * s.y) + abs(s.x * s.y);
-        r = ceil((r + 1.0) * (1.0 / c.y + a * along)) - 1.0;
+    uint size = block_size(f);
+    // Bilinear reads reach one texel past the block: the kernel is non-zero for kernel offsets
+    // inside the square of half-side r + 1. Screen offsets are its image under the inverse map
+    // (1/c_t)·I + (1/c_r − 1/c_t)·e·eᵀ, whose extent along a grid axis is the largest row sum
+    // of its absolute values.
+    float a = 1.0 / c.x - 1.0 / c.y;
+    float along = max(s.x * s.x, s.y * s.y) + abs(s.x * s.y);
+    float stretch = c.x < 1.0 ? 1.0 / c.y + a * along : 1.0;
+    if (size >= 4u) {
+        // Non-zero strictly within r + s/2 + ½ of the centre; pixel offsets are half-integers.
+        return ceil((r + 0.5 * float(size) + 0.5) * stretch - 0.5) - 0.5;
     }
-    return block_size(f) > 1u ? r + 0.5 : r;
+    if (c.x < 1.0) {
+        r = ceil((r + 1.0) * stretch) - 1.0;
+    }
+    return size > 1u ? r + 0.5 : r;
 }
 
 // Inclusive rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of the

@@ -163,14 +163,16 @@ pub struct SplatArgs {
     #[arg(long, value_enum, default_value = "auto")]
     pub texture_format: crate::render::splat::PsfTextureFormat,
     /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4 blocks, … 5 = up to 32×32.
-    #[arg(long, default_value_t = 1)]
+    /// A merged block reads its pixels' kernel summed over the block (exact for one colour).
+    #[arg(long, default_value_t = crate::render::splat::MergeSettings::DEFAULT_LEVELS)]
     pub merge_levels: u32,
-    /// Level of detail by blur: merge a block of side s once every kernel in it is at least
-    /// this many times s in radius, whatever its colours (0 = the seed paper's colour rule).
+    /// Level of detail by blur: merge a block of side s only where every kernel in it is at
+    /// least this many times s in radius (0 = any side, the seed paper's rule); colours and
+    /// depths must also agree within their tolerances per pixel of blur.
     #[arg(
         long,
         value_name = "K",
-        default_value_t = 0.0,
+        default_value_t = crate::render::splat::MergeSettings::DEFAULT_BLUR_PER_BLOCK,
         allow_hyphen_values = true
     )]
     pub merge_blur_per_block: f32,

@@ -14,6 +14,8 @@ pub struct Frame {
     /// Focal length in pixels for the wide-field geometry; 0 = the centre's scale everywhere
     /// and view-axis vergence.
     pub focal_px: f32,
+    /// The blend's depth-group tolerance (D): a merged block lies within one group.
+    pub group_tolerance_d: f32,
 }
 
 impl Frame {
@@ -81,7 +83,7 @@ pub fn fragments(
         .collect()
 }
 
-/// One merge level (block `size` 2 or 4) following the rules in merge.comp's header.
+/// One merge level (block `size` 2, 4, …) following the rules in merge.comp.
 /// `core`: per object distance, the smallest core radius over the channels (merge.comp).
 pub fn merge_level(
     frame: &Frame,
@@ -110,7 +112,19 @@ pub fn merge_level(
                 .iter()
                 .flat_map(|x| x.radius.into_iter().chain([core_of(x)]))
                 .fold(f32::INFINITY, f32::min);
-            if r_min < settings.min_radius_px {
+            if r_min
+                < settings
+                    .min_radius_px
+                    .max(settings.blur_per_block * size as f32)
+            {
+                continue;
+            }
+            let (lo, hi) = f
+                .iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x.dioptre), hi.max(x.dioptre))
+                });
+            if hi - lo > frame.group_tolerance_d {
                 continue;
             }
             let mut ok = true;
@@ -134,18 +148,10 @@ pub fn merge_level(
             m.depth = f.iter().map(|x| x.depth).fold(f32::INFINITY, f32::min);
             m.index = 0.25 * f.iter().map(|x| x.index).sum::<f32>();
             m.dioptre = 0.25 * f.iter().map(|x| x.dioptre).sum::<f32>();
-            // A 2×2 block keeps its children's kernel (the bilinear lookup half a pixel off the
-            // grid averages it over the four pixels); a 4×4 block matches the second moment of
-            // its four 2×2 blocks: R'² = R² + (s² − c²)/3.
-            let grow = if size == 2 {
-                0.0
-            } else {
-                (size * size - child * child) as f32 / 3.0
-            };
-            m.radius = [0, 1, 2].map(|c| {
-                let r = f.iter().map(|x| x.radius[c]).fold(0.0, f32::max);
-                (r * r + grow).sqrt().min(frame.max_radius as f32)
-            });
+            // Every block keeps its children's kernel: a 2×2 block reads it half a pixel off the
+            // grid (the bilinear lookup sums it over the four pixels), a larger one reads its
+            // block-summed kernel.
+            m.radius = [0, 1, 2].map(|c| f.iter().map(|x| x.radius[c]).fold(0.0, f32::max));
             m.center = [
                 (bx * size) as f32 + 0.5 * size as f32,
                 (by * size) as f32 + 0.5 * size as f32,
@@ -169,6 +175,7 @@ pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
     let t = (radius - 0.5).clamp(0.0, 1.0);
     let (cr, ct) = (1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0));
     // The extent of the square |k| < r + 1 under the inverse map along the screen axes.
+    let mut stretch = 1.0;
     if cr < 1.0 {
         let u = f.center[0] - 0.5 * frame.width as f32;
         let v = f.center[1] - 0.5 * frame.height as f32;
@@ -176,9 +183,17 @@ pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
         let (ex, ey) = (u / rho, v / rho);
         let a = 1.0 / cr - 1.0 / ct;
         let along = (ex * ex).max(ey * ey) + (ex * ey).abs();
-        r = ((r + 1.0) * (1.0 / ct + a * along)).ceil() - 1.0;
+        stretch = 1.0 / ct + a * along;
+        r = ((r + 1.0) * stretch).ceil() - 1.0;
     }
-    let reach = if f.size > 1 { r + 0.5 } else { r };
+    let reach = if f.size >= 4 {
+        // a block-summed kernel: (2r + s)² texels, non-zero within r + s/2 + ½
+        ((radius.ceil() + 0.5 * f.size as f32 + 0.5) * stretch - 0.5).ceil() - 0.5
+    } else if f.size > 1 {
+        r + 0.5
+    } else {
+        r
+    };
     let x0 = ((f.center[0] - 0.5 - reach).ceil() as i64).max(0);
     let y0 = ((f.center[1] - 0.5 - reach).ceil() as i64).max(0);
     let x1 = ((f.center[0] - 0.5 + reach).floor() as i64).min(frame.width as i64 - 1);

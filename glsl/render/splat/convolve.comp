@@ -55,17 +55,22 @@ shared vec4 batch_node_weights[64];
 shared uint unsaturated;       // threads with a pixel whose closed groups cover < 1 − ε
 
 // RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block) of
-// field node `node`, at offset d from the kernel's centre. Past the block's zero ring, and
-// past the largest level, the kernel is zero and the atlas holds other blocks or nothing:
+// field node `node`, at offset d from the kernel's centre; a merged block of 4×4 pixels and up
+// reads the level's kernel summed over its side (kernel_slot). Past the slot's zero ring, and
+// past the largest level, the kernel is zero and the atlas holds other slots or nothing:
 // nothing is read there.
-vec3 kernel_rgb(vec2 d, float l, float index, uint node) {
+vec3 kernel_rgb(vec2 d, float l, float index, uint node, uint size) {
     uint level = uint(l);
-    uint r = level_block_radius(level);
-    if (level >= level_count() || any(greaterThanEqual(abs(d), vec2(float(r + 1u))))) {
+    if (level >= level_count()) {
         return vec3(0.0);
     }
+    uint slot = kernel_slot(level, size);
+    if (any(greaterThanEqual(abs(d), vec2(slot_bound(slot, level))))) {
+        return vec3(0.0);
+    }
+    uint r = level_block_radius(level);
     vec3 extent = vec3(textureSize(psf_texture, 0));
-    vec3 uvw = vec3((vec2(kernel_centre(node, level)) + 0.5 + d) / extent.xy,
+    vec3 uvw = vec3((vec2(node_origin(node)) + slot_point(slot) + d) / extent.xy,
                     (index + 0.5) / extent.z);
     float k = float(2u * r + 1u);
     return textureLod(psf_texture, uvw, 0.0).rgb / (k * k);
@@ -75,6 +80,7 @@ vec3 kernel_rgb(vec2 d, float l, float index, uint node) {
 // lies between two radius levels; when all channels' levels fall within three consecutive ones
 // (the usual case), the three lookups serve every channel, else each channel takes its own two.
 vec3 kernel_at(Fragment f, vec2 d, uint node) {
+    uint size = block_size(f);
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
     vec3 t = level - lo;
@@ -82,9 +88,9 @@ vec3 kernel_at(Fragment f, vec2 d, uint node) {
     float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
     vec3 w;
     if (top - base <= 2.0) {
-        vec3 s0 = kernel_rgb(d, base, f.index, node);
-        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index, node) : s0;
-        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index, node) : s1;
+        vec3 s0 = kernel_rgb(d, base, f.index, node, size);
+        vec3 s1 = top > base ? kernel_rgb(d, base + 1.0, f.index, node, size) : s0;
+        vec3 s2 = top > base + 1.0 ? kernel_rgb(d, base + 2.0, f.index, node, size) : s1;
         // Component-wise selection (no dynamic indexing): channel c reads s[i0] and s[i0 + 1].
         vec3 i0 = lo - base;
         vec3 a = mix(mix(s0, s1, step(0.5, i0)), s2, step(1.5, i0));
@@ -92,8 +98,8 @@ vec3 kernel_at(Fragment f, vec2 d, uint node) {
         w = mix(a, b, t);
     } else {
         [[unroll]] for (int c = 0; c < 3; c++) {
-            float a = kernel_rgb(d, lo[c], f.index, node)[c];
-            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, node)[c], t[c]) : a;
+            float a = kernel_rgb(d, lo[c], f.index, node, size)[c];
+            w[c] = t[c] > 0.0 ? mix(a, kernel_rgb(d, lo[c] + 1.0, f.index, node, size)[c], t[c]) : a;
         }
     }
     return w;

@@ -72,7 +72,7 @@ const uint READS = 3u;
 shared vec4 slot_reach[SLOTS];     // centre.xy, reach, the texture layer coordinate
 shared vec4 slot_scale[SLOTS];     // radial unit vector, radial and tangential shrink ((1, 1): none)
 shared vec4 slot_color[SLOTS];     // linear RGB, vergence (D)
-shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's centre texel + ½, bound r + 1, red coefficient
+shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's offset 0 (slot_point), bound, red coefficient
 shared vec4 slot_gb[SLOTS * 2u];   // green and blue coefficients of the three reads, then the
                                    // weight applied after the reads and the per-fragment blend's
                                    // block pixel count (1 otherwise)
@@ -160,9 +160,10 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
         bool used = i < plan.counts[s];
         uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
         coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
+        // A merged block of 4×4 and up reads its side's block-summed kernel (kernel_slot).
+        uint at = kernel_slot(l, block_size(f));
         // An unused read stays harmless: its bound rejects every offset.
-        slot_read[READS * j + i] = vec4(vec2(level_centres[l].xy) + 0.5,
-                                        used ? float(level_block_radius(l) + 1u) : 0.0, coef[i].r);
+        slot_read[READS * j + i] = vec4(slot_point(at), used ? slot_bound(at, l) : 0.0, coef[i].r);
     }
     slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);

@@ -2,8 +2,9 @@
 // Merges blocks of strongly blurred fragments into one fragment, in place: the merged
 // fragment takes the block's top-left slot, the others are marked merged away (size 0).
 // One dispatch per block size (`MergePush` in src/render/splat/merge.rs): 2 merges 2×2 single
-// pixels, 4 merges 2×2 already-merged 2×2 blocks, and so on up to 32. Thresholds scale with the block's smallest blur radius: the more
-// blur, the less a small difference in colour or dioptre can show.
+// pixels, 4 merges 2×2 already-merged 2×2 blocks, and so on up to 32. Thresholds scale with
+// the block's smallest blur radius: the more blur, the less a small difference in colour or
+// dioptre can show.
 #extension GL_GOOGLE_include_directive : require
 #define FRAME_BINDING 5
 #include "splat.glsl"
@@ -12,9 +13,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(push_constant) uniform MergePush {
     uint block_size;       // side of the blocks this dispatch makes (2, 4, … 32)
-    // Level of detail by blur (> 0): a block of side s merges when every child's kernels are
-    // at least this many times s in radius, whatever its colours; 0: the seed paper's rule
-    // (colour and dioptre tolerances per pixel of blur).
+    // k: a block of side s merges only when every child's kernels are at least k·s in radius
+    // (0: any side, the seed paper's rule).
     float blur_per_block;
 } push;
 
@@ -60,56 +60,51 @@ void main() {
     for (int k = 0; k < 4; k++) {
         r_min = min(r_min, min(min3(f[k].radius), core_radius(f[k])));
     }
-    if (r_min < frame.merge_min_radius) {
+    // Three conditions, each a bound on what averaging the block changes. Its pixels keep
+    // their kernel (the block reads the kernel summed over its pixels, below), so what merging
+    // averages is their colours and depths: (1) the block is no wider than the blur allows,
+    // s ≤ r / k (`blur_per_block`, 0: any side) and r at least the minimum radius;
+    // (2) colours within the tolerance per pixel of blur (the seed paper's rule: under a wide
+    // kernel a colour difference spreads thin); (3) the depths' summed spread within its
+    // tolerance per pixel of blur, and the whole block in one depth group of the blend, so the
+    // merged fragment joins the group its pixels would have.
+    if (r_min < max(frame.merge_min_radius, push.blur_per_block * float(size))) {
         return;
     }
-    if (push.blur_per_block > 0.0) {
-        // Level of detail: under a kernel k·s wide or more, a block of s × s pixels is resolved
-        // finer than the blur can show, and its mean colour spread by the block's kernel is what
-        // the eye sees (the kernel is read at the block's centre, grown by the block's second
-        // moment below: PSF ⊛ block, light conserved). What must stay apart is depth: the
-        // children's vergences lie within the blend's group tolerance, so the merged fragment
-        // joins the same depth group and reads the same kernels.
-        if (r_min < push.blur_per_block * float(size)) {
-            return;
-        }
-        float lo = 1e30;
-        float hi = -1e30;
-        for (int k = 0; k < 4; k++) {
-            lo = min(lo, f[k].dioptre);
-            hi = max(hi, f[k].dioptre);
-        }
-        if (hi - lo > frame.group_tolerance_d) {
-            return;
-        }
-    } else {
-        float dioptre_spread = 0.0;
-        for (int a = 0; a < 4; a++) {
-            for (int b = a + 1; b < 4; b++) {
-                vec3 dc = abs(f[a].color - f[b].color);
-                if (max3(dc) >= frame.merge_color_tolerance * r_min) {
-                    return;
-                }
-                dioptre_spread += abs(f[a].index - f[b].index) * frame.dioptre_step;
+    float lo = 1e30;
+    float hi = -1e30;
+    for (int k = 0; k < 4; k++) {
+        lo = min(lo, f[k].dioptre);
+        hi = max(hi, f[k].dioptre);
+    }
+    if (hi - lo > frame.group_tolerance_d) {
+        return;
+    }
+    float dioptre_spread = 0.0;
+    for (int a = 0; a < 4; a++) {
+        for (int b = a + 1; b < 4; b++) {
+            vec3 dc = abs(f[a].color - f[b].color);
+            if (max3(dc) >= frame.merge_color_tolerance * r_min) {
+                return;
             }
+            dioptre_spread += abs(f[a].index - f[b].index) * frame.dioptre_step;
         }
-        if (dioptre_spread >= 6.0 * frame.merge_dioptre_tolerance * r_min) {
-            return;
-        }
+    }
+    if (dioptre_spread >= 6.0 * frame.merge_dioptre_tolerance * r_min) {
+        return;
     }
     Fragment m;
     m.color = 0.25 * (f[0].color + f[1].color + f[2].color + f[3].color);
     m.depth = min(min(f[0].depth, f[1].depth), min(f[2].depth, f[3].depth));
     m.index = 0.25 * (f[0].index + f[1].index + f[2].index + f[3].index);
     vec3 r_max = max(max(f[0].radius, f[1].radius), max(f[2].radius, f[3].radius));
-    // The block spreads its light over size × size pixels. A 2×2 block's centre lies half a
-    // pixel off the pixel grid, so the convolution's bilinear lookup there averages the kernel
-    // over the four pixels' offsets: the kernel itself, unscaled, is exact (scaling it would
-    // also scale an asymmetric PSF's centroid offset). A 4×4 block of four 2×2 blocks adds
-    // their ±1 px spread: match the second moment (a disc of radius R has R²/4 per axis), so
-    // R'² = R² + 4 = R² + (s² − c²)/3. (The seed paper adds √2·(s − 1)/2, which over-blurs.)
-    float grow = size == 2u ? 0.0 : float(size * size - child * child) / 3.0;
-    m.radius = min(sqrt(r_max * r_max + grow), vec3(float(frame.max_radius)));
+    // The block spreads its light over size × size pixels, each pixel by the same kernel from
+    // its own position. A 2×2 block's centre lies half a pixel off the pixel grid, so the
+    // convolution's bilinear lookup there averages the kernel over the four pixels' offsets:
+    // the kernel itself is exact. A block of 4×4 and up reads its level's kernel summed over
+    // the block (glsl/common/atlas.glsl, kernel_slot): exact too, the kernel's shape and any
+    // centroid offset kept. The radius stays the children's, which picks the levels.
+    m.radius = max(max(f[0].radius, f[1].radius), max(f[2].radius, f[3].radius));
     m.center = vec2(origin) + 0.5 * float(size);
     m.size = size;
     m.dioptre = 0.25 * (f[0].dioptre + f[1].dioptre + f[2].dioptre + f[3].dioptre);

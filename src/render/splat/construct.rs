@@ -63,7 +63,8 @@ impl Splatter {
                 settings.tile_size
             )));
         }
-        let layout = field::TextureLayout::new(&grid, field_axes.as_ref());
+        let blocks = field::block_kernels(&settings.merge, grid.max_radius_px);
+        let layout = field::TextureLayout::new(&grid, field_axes.as_ref(), &blocks);
         layout.check(ctx, settings.texture_format.texel_bytes())?;
         let nodes: &[KernelGrid] = if node_grids.is_empty() {
             std::slice::from_ref(&grid)

@@ -261,6 +261,17 @@ impl Splatter {
         self.layout.centre(node, level)
     }
 
+    /// Where radius level `level`'s kernel summed over merged blocks of `side` × `side` pixels
+    /// (4 … 32) lies at field node `node`, if the texture holds it: the texel whose centre is
+    /// offset (+½, +½) from the block's centre (glsl/common/atlas.glsl).
+    pub fn psf_texture_block_centre(&self, node: u32, level: u32, side: u32) -> Option<[u32; 2]> {
+        let (b, slot) = self.layout.blocks.iter().find(|(b, _)| b.side == side)?;
+        (level >= b.first_level).then(|| {
+            self.layout
+                .slot_centre(node, (slot + level - b.first_level) as usize)
+        })
+    }
+
     /// Renders one frame through the eye's kernels for `view`.
     pub fn render(
         &mut self,
@@ -558,6 +569,7 @@ impl Splatter {
                 // (Measured: without it, two splat tests read NaN on lavapipe.)
                 rec.clear_image(&self.texture, [0.0; 4]);
             }
+            let blocks: Vec<field::BlockKernels> = self.layout.blocks.iter().map(|b| b.0).collect();
             for (node, resident) in self.resident.iter().enumerate() {
                 self.psf_texture.record(
                     rec,
@@ -567,6 +579,7 @@ impl Splatter {
                     node as u32,
                     &self.texture,
                     &self.atlas,
+                    &blocks,
                 )?;
             }
         }

@@ -9,11 +9,13 @@ use crate::psf::kernels::{
     level_block_radius, level_count, texels_below_level, GridBlend, KernelGrid, KernelSet,
 };
 
+use super::field::BlockKernels;
 use super::{FrameBlock, FrameUniform};
 
-/// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node).
-/// Mirrors `PsfTexturePush` in glsl/render/splat/psf_texture.comp (std430: the vec4 sits at
-/// offset 16, right after the four uints).
+/// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node, its
+/// plain kernels or one block side's). Mirrors `PsfTexturePush` in
+/// glsl/render/splat/psf_texture.comp (std430: the vec4 sits at offset 16, right after the
+/// four uints).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub(super) struct PsfTexturePush {
@@ -27,6 +29,9 @@ pub(super) struct PsfTexturePush {
     pub node: u32,
     /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
     pub corner_weights: [f32; 4],
+    /// 0: the plain kernels; 4, 8, 16 or 32: the kernels summed over blocks of that side.
+    pub block_side: u32,
+    pub _pad: [u32; 3],
 }
 
 /// Texel format of the PSF texture: half floats halve memory and bandwidth; kernels are
@@ -186,7 +191,9 @@ impl PsfTexturePass {
     }
 
     /// Writes field node `node`'s kernels for `blend` into its region of `texture`, whose
-    /// layout `atlas` holds (glsl/common/atlas.glsl).
+    /// layout `atlas` holds (glsl/common/atlas.glsl): the plain kernels, then per block side
+    /// of `blocks` its block-summed ones (a block's texels read the chunk's kernel sets, so
+    /// each chunk writes its own levels of every kind).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -197,6 +204,7 @@ impl PsfTexturePass {
         node: u32,
         texture: &Image,
         atlas: &Buffer,
+        blocks: &[BlockKernels],
     ) -> GpuResult<()> {
         let chunks = grid.sets[blend.corners[0].0].len();
         for chunk in 0..chunks {
@@ -205,30 +213,41 @@ impl PsfTexturePass {
                 |k: usize| &grid.sets[blend.corners.get(k).unwrap_or(&blend.corners[0]).0][chunk];
             let weight = |k: usize| blend.corners.get(k).map_or(0.0, |c| c.1 as f32);
             let first = corner(0);
-            let push = PsfTexturePush {
-                first_level: first.first_level,
-                end_level: first.end_level,
-                first_texel: first.first_texel,
-                node,
-                corner_weights: [weight(0), weight(1), weight(2), weight(3)],
-            };
             let layers = (first.end_level - first.first_level) * frame.values.object_count;
-            // the chunk's largest block with its ring of zeros
-            let side = 2 * level_block_radius(first.end_level - 1) + 3;
-            rec.dispatch(
-                &self.pipeline,
-                &[
-                    Binding::Buffer(&corner(0).buffer),
-                    Binding::Buffer(&corner(1).buffer),
-                    Binding::Buffer(&corner(2).buffer),
-                    Binding::Buffer(&corner(3).buffer),
-                    Binding::Storage(texture),
-                    Binding::Buffer(atlas),
-                    frame.binding(),
-                ],
-                &push,
-                [side.div_ceil(8), side.div_ceil(8), layers],
-            )?;
+            let largest = level_block_radius(first.end_level - 1);
+            // Plain kernels (side 0), then each block side whose levels this chunk holds; each
+            // dispatch covers the chunk's largest slot with its ring of zeros.
+            let kinds = std::iter::once((0, 2 * largest + 3)).chain(
+                blocks
+                    .iter()
+                    .filter(|b| b.first_level < first.end_level)
+                    .map(|b| (b.side, 2 * largest + b.side + 2)),
+            );
+            for (block_side, side) in kinds {
+                let push = PsfTexturePush {
+                    first_level: first.first_level,
+                    end_level: first.end_level,
+                    first_texel: first.first_texel,
+                    node,
+                    corner_weights: [weight(0), weight(1), weight(2), weight(3)],
+                    block_side,
+                    _pad: [0; 3],
+                };
+                rec.dispatch(
+                    &self.pipeline,
+                    &[
+                        Binding::Buffer(&corner(0).buffer),
+                        Binding::Buffer(&corner(1).buffer),
+                        Binding::Buffer(&corner(2).buffer),
+                        Binding::Buffer(&corner(3).buffer),
+                        Binding::Storage(texture),
+                        Binding::Buffer(atlas),
+                        frame.binding(),
+                    ],
+                    &push,
+                    [side.div_ceil(8), side.div_ceil(8), layers],
+                )?;
+            }
         }
         Ok(())
     }

@@ -10,11 +10,12 @@ pub struct MergeSettings {
     /// 0 = off, 1 = 2×2 blocks, 2 = 2×2 and then 4×4 blocks, … up to [`MAX_MERGE_LEVELS`]
     /// (32×32).
     pub levels: u32,
-    /// Level of detail by blur: a block of side s merges when the kernels of all its pixels are
-    /// at least `blur_per_block`·s in radius (and their vergences within the blend's group
-    /// tolerance), whatever its colours, so a pixel is reached by about (2·k + 1)² fragments
-    /// per surface however large the blur. 0: the seed paper's rule (`color_tolerance` and
-    /// `dioptre_tolerance`).
+    /// Level of detail by blur, k: a block of side s merges only when the kernels of all its
+    /// pixels are at least k·s in radius, so a pixel is reached by at most about (2k + 1)²…
+    /// (4k + 1)² fragments per merged surface however large the blur. 0: any side (the seed
+    /// paper's rule, which lets a 32×32 block merge under a 5 px kernel). Each merged block
+    /// reads its pixels' kernel summed over the block, so what merging averages is only the
+    /// pixels' colours and depths, which the other tolerances bound.
     pub blur_per_block: f32,
     /// Smallest blur radius (px, over the block and the channels) for a block to merge.
     pub min_radius_px: f32,
@@ -24,12 +25,20 @@ pub struct MergeSettings {
     pub dioptre_tolerance: f32,
 }
 
+impl MergeSettings {
+    /// Block sides up to 32×32, each no wider than the blur's radius.
+    pub const DEFAULT_LEVELS: u32 = 5;
+    pub const DEFAULT_BLUR_PER_BLOCK: f32 = 1.0;
+}
+
 impl Default for MergeSettings {
     fn default() -> Self {
-        // The seed paper's framework defaults.
+        // The seed paper's tolerances (its framework merged 2×2 blocks only); blocks up to
+        // 32×32 no wider than the blur, which the block-summed kernels make exact but for the
+        // averaged colours (validation.md, "Merging").
         MergeSettings {
-            levels: 1,
-            blur_per_block: 0.0,
+            levels: MergeSettings::DEFAULT_LEVELS,
+            blur_per_block: MergeSettings::DEFAULT_BLUR_PER_BLOCK,
             min_radius_px: 5.0,
             color_tolerance: 0.10,
             dioptre_tolerance: 0.01,
