@@ -114,7 +114,11 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
                 end_level,
                 first_texel,
                 node,
-                corner_weights
+                corner_weights,
+                block_side,
+                pad0,
+                pad1,
+                pad2
             })),
         ),
         (

@@ -31,7 +31,10 @@ pub(super) struct PsfTexturePush {
     pub corner_weights: [f32; 4],
     /// 0: the plain kernels; 4, 8, 16 or 32: the kernels summed over blocks of that side.
     pub block_side: u32,
-    pub _pad: [u32; 3],
+    /// To the block's 48 bytes (std430 rounds it to the vec4's alignment).
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// Texel format of the PSF texture: half floats halve memory and bandwidth; kernels are
@@ -231,7 +234,9 @@ impl PsfTexturePass {
                     node,
                     corner_weights: [weight(0), weight(1), weight(2), weight(3)],
                     block_side,
-                    _pad: [0; 3],
+                    pad0: 0,
+                    pad1: 0,
+                    pad2: 0,
                 };
                 rec.dispatch(
                     &self.pipeline,
