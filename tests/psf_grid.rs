@@ -390,9 +390,10 @@ fn a_single_frame_needs_one_column() {
     .unwrap();
     assert_eq!(frame.axes.focus_d, vec![0.5]);
     assert_eq!(frame.axes.pupils_mm, vec![4.2]);
-    assert_eq!(frame.axes.objects.count, 41);
-    assert_eq!(frame.psfs, 123);
-    assert_eq!(frame.skipped_psfs, 2460 - 123);
+    // 0..10 D on the reference's 1/16 D steps, extended to the scene's 10.125 D
+    assert_eq!(frame.axes.objects.count, 163);
+    assert_eq!(frame.psfs, 489);
+    assert_eq!(frame.skipped_psfs, 9660 - 489);
     // a shallow scene needs a few objects only, on the reference's sample positions
     let shallow = plan_for_scene(
         &SceneNeeds {
@@ -406,9 +407,10 @@ fn a_single_frame_needs_one_column() {
     )
     .unwrap();
     let o = shallow.axes.objects;
-    assert!(o.min_d <= 1.3 - 0.25 + 1e-9 && o.max_d() >= 2.0 + 0.25 - 1e-9);
-    assert_eq!(o.count, 7, "{o:?}"); // 1.125..2.125 brackets the scene, plus one each side
-    assert!(((o.min_d - 0.125) / 0.25 - ((o.min_d - 0.125) / 0.25).round()).abs() < 1e-9);
+    let step = reference.objects.step_d;
+    assert!(o.min_d <= 1.3 - step + 1e-9 && o.max_d() >= 2.0 + step - 1e-9);
+    assert_eq!(o.count, 15, "{o:?}"); // 1.25..2.0 brackets the scene, plus one each side
+    assert!((o.min_d / step - (o.min_d / step).round()).abs() < 1e-9);
     // four focus values are covered by the reference points that bracket them
     assert!(
         shallow.axes.focus_d.len() <= 3,

@@ -25,7 +25,7 @@ pub struct KernelsArgs {
     pub eye: String,
     #[command(flatten)]
     pub correction: super::correction::CorrectionArgs,
-    /// Object distances in dioptres: MIN..MAX:COUNT, uniform [default: 0.125..10.125:41].
+    /// Object distances in dioptres: MIN..MAX:COUNT, uniform [default: 0..10:161].
     #[arg(long, value_name = "MIN..MAX:N")]
     pub objects: Option<String>,
     /// Focus states in dioptres, comma-separated, increasing; 0 = infinity
