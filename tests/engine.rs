@@ -73,6 +73,20 @@ const VIEW: ViewState = ViewState {
     focus_d: 0.5,
 };
 
+/// The settings of the tests that size lists: merging of 2×2 blocks only, as the seed paper
+/// did, so that the blurred textured frame keeps long lists (the default merges its blocks up
+/// to 32×32, as its colours agree within the tolerance of its large blur).
+fn list_settings() -> SplatSettings {
+    SplatSettings {
+        merge: MergeSettings {
+            levels: 1,
+            blur_per_block: 0.0,
+            ..MergeSettings::default()
+        },
+        ..SplatSettings::default()
+    }
+}
+
 fn render(splatter: &mut Splatter, frame: &Frame, view: ViewState) -> SplatOutput {
     splatter.render(&frame.input(), view, false).unwrap()
 }
@@ -158,7 +172,7 @@ fn a_frame_that_outgrows_the_lists_falls_back_to_bands() {
     let ctx = common::gpu();
     let sharp = Frame::new(|x, y| (textured(x, y), 2.0)); // 0.5 D: near focus, short lists
     let blurred = Frame::new(|x, y| (textured(x, y), 0.2)); // 5 D: long lists
-    let mut splatter = Splatter::new(&ctx, grid(), SplatSettings::default()).unwrap();
+    let mut splatter = Splatter::new(&ctx, grid(), list_settings()).unwrap();
     render(&mut splatter, &sharp, VIEW);
     let steady = render(&mut splatter, &sharp, VIEW);
     assert_eq!(steady.stats.submissions, 1);
@@ -167,7 +181,7 @@ fn a_frame_that_outgrows_the_lists_falls_back_to_bands() {
     // More than the list buffer's 25 % headroom over the steady frame.
     assert!(4 * grown.stats.list_entries > 5 * steady.stats.list_entries);
     assert_eq!(grown.stats.submissions, 3, "one try, then planned bands");
-    let mut fresh = Splatter::new(&ctx, grid(), SplatSettings::default()).unwrap();
+    let mut fresh = Splatter::new(&ctx, grid(), list_settings()).unwrap();
     let expected = render(&mut fresh, &blurred, VIEW);
     assert_eq!(grown.color, expected.color);
     drop((splatter, fresh));
@@ -183,14 +197,14 @@ fn banded_steady_frames_are_one_submission() {
     let ctx = common::gpu();
     let blurred = Frame::new(|x, y| (textured(x, y), 0.2)); // 5 D from focus: long lists
     let sharp = Frame::new(|x, y| (textured(x, y), 2.0)); // 0.5 D: at focus, short lists
-    let mut whole = Splatter::new(&ctx, grid(), SplatSettings::default()).unwrap();
+    let mut whole = Splatter::new(&ctx, grid(), list_settings()).unwrap();
     let expected = render(&mut whole, &blurred, VIEW);
     assert_eq!(expected.stats.bands, 1);
     let entries = expected.stats.list_entries;
     // A list budget of a quarter of the frame's lists: four or five bands.
     let banded_settings = SplatSettings {
         max_list_bytes: entries * 8 / 4,
-        ..SplatSettings::default()
+        ..list_settings()
     };
     let mut banded = Splatter::new(&ctx, grid(), banded_settings).unwrap();
     let first = render(&mut banded, &blurred, VIEW);
@@ -225,7 +239,7 @@ fn banded_steady_frames_are_one_submission() {
         "{:?}",
         short.stats
     );
-    let mut fresh = Splatter::new(&ctx, grid(), SplatSettings::default()).unwrap();
+    let mut fresh = Splatter::new(&ctx, grid(), list_settings()).unwrap();
     assert_eq!(short.color, render(&mut fresh, &sharp, VIEW).color);
     // Back to the blurred frame: more bands than the sharp frame's slots (its bands and a
     // spare), so the GPU's plan is incomplete and the frame is planned on the host.
