@@ -34,7 +34,9 @@ for c in "${cases[@]}"; do
       --json "$out/$scene-$eye-$size-$which.json" > "$out/$scene-$eye-$size-$which.txt"
   done
 done
-# the growth from 320×180 to 640×360 and `ocular render` with no arguments (warm cache)
+# the growth from 320×180 to 640×360 and `ocular render` with no arguments (warm cache: the
+# first, untimed render fills the kernel cache if it is cold)
+"$new_bin" render -o "$out/default.png" > /dev/null
 start=$(date +%s.%N)
 "$new_bin" render -o "$out/default.png" > /dev/null
 end=$(date +%s.%N)
