@@ -204,7 +204,7 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
         let text = stderr(&o);
         assert_eq!(text.matches("warning:").count(), 1, "{extra:?}: {text}");
         assert!(
-            text.contains("1 pixel(s) nearer than 0.0201 m") && text.contains("d.exr"),
+            text.contains("1 pixel(s) nearer than 0.0200 m") && text.contains("d.exr"),
             "{text}"
         );
         assert_eq!(s["warnings"].as_array().unwrap().len(), 1);

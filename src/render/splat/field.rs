@@ -429,18 +429,20 @@ mod tests {
         let b = block_kernels(&seed, 11);
         assert_eq!(b.iter().map(|b| b.side).collect::<Vec<_>>(), [4, 8]);
         assert!(b.iter().all(|b| level_radius_px(b.first_level) == 4.0));
-        // The default: every side up to 32, each from the radius of its own side (k = 1).
-        let b = block_kernels(&crate::render::splat::MergeSettings::default(), 40);
+        // All five levels at the default k = 1: every side up to 32, each from the radius of
+        // its own side (and the 5 px minimum).
+        let all = crate::render::splat::MergeSettings {
+            levels: 5,
+            ..Default::default()
+        };
+        let b = block_kernels(&all, 40);
         let starts: Vec<(u32, f64)> = b
             .iter()
             .map(|b| (b.side, level_radius_px(b.first_level)))
             .collect();
         assert_eq!(starts, [(4, 4.0), (8, 7.0), (16, 15.0), (32, 31.0)]);
-        let seed_2x2 = crate::render::splat::MergeSettings {
-            levels: 1,
-            ..Default::default()
-        };
-        assert!(block_kernels(&seed_2x2, 40).is_empty());
+        // The default merges 2×2 blocks only: no block kernels.
+        assert!(block_kernels(&crate::render::splat::MergeSettings::default(), 40).is_empty());
     }
 
     /// The atlas against the equal-layer layout it replaced, (2·Rmax + 1 + 2)² texels per

@@ -27,15 +27,13 @@ pub struct MergeSettings {
 
 impl MergeSettings {
     /// Block sides up to 32×32, each no wider than the blur's radius.
-    pub const DEFAULT_LEVELS: u32 = 5;
+    pub const DEFAULT_LEVELS: u32 = 1;
     pub const DEFAULT_BLUR_PER_BLOCK: f32 = 1.0;
 }
 
 impl Default for MergeSettings {
     fn default() -> Self {
-        // The seed paper's tolerances (its framework merged 2×2 blocks only); blocks up to
-        // 32×32 no wider than the blur, which the block-summed kernels make exact but for the
-        // averaged colours (validation.md, "Merging").
+        // The seed paper's framework defaults; with more levels, no block wider than the blur.
         MergeSettings {
             levels: MergeSettings::DEFAULT_LEVELS,
             blur_per_block: MergeSettings::DEFAULT_BLUR_PER_BLOCK,
