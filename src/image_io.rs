@@ -6,45 +6,8 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+pub use crate::image_types::{ImageGray, ImageRgba};
 use crate::{Error, Result};
-
-/// Linear RGBA, row-major, top row first.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ImageRgba {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<[f32; 4]>,
-}
-
-/// One channel (depth in metres, luminance, …), row-major, top row first.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ImageGray {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<f32>,
-}
-
-impl ImageRgba {
-    pub fn new(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> ImageRgba {
-        assert_eq!(pixels.len(), width as usize * height as usize);
-        ImageRgba {
-            width,
-            height,
-            pixels,
-        }
-    }
-}
-
-impl ImageGray {
-    pub fn new(width: u32, height: u32, pixels: Vec<f32>) -> ImageGray {
-        assert_eq!(pixels.len(), width as usize * height as usize);
-        ImageGray {
-            width,
-            height,
-            pixels,
-        }
-    }
-}
 
 /// Relative luminance of linear Rec.709/sRGB primaries; in ocular's calibrated frames it is
 /// in cd/m².

@@ -10,6 +10,7 @@ pub mod error;
 pub mod eye;
 pub mod gpu;
 pub mod image_io;
+mod image_types;
 pub mod inputs;
 pub mod limits;
 pub mod metrics;

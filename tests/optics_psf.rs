@@ -5,7 +5,7 @@ use num_complex::Complex64;
 use ocular::aberrations::preset;
 use ocular::optics::bessel::{bessel_j, bessel_j_sequence};
 use ocular::optics::psf::{compute_psf, defocus_f_from_dioptres, Psf, PsfRequest};
-use ocular::optics::quadrature::{fft_in_place, gauss_legendre_01};
+use ocular::optics::quadrature::gauss_legendre_01;
 use ocular::optics::zernike::wavefront;
 use ocular::optics::zernike::{num_terms, osa_index};
 use std::f64::consts::PI;
@@ -28,6 +28,7 @@ impl Direct {
         let lam = wavelength_nm * 1e-3;
         let mmax = ntheta / 2 - 1;
         let mut rings = Vec::new();
+        let fft = rustfft::FftPlanner::<f64>::new().plan_fft_forward(ntheta);
         for &rho in &xs {
             let mut ring: Vec<Complex64> = (0..ntheta)
                 .map(|k| {
@@ -36,7 +37,7 @@ impl Direct {
                     Complex64::from_polar(1.0, 2.0 * PI * w / lam + f * rho * rho)
                 })
                 .collect();
-            fft_in_place(&mut ring);
+            fft.process(&mut ring);
             let mut h = vec![Complex64::default(); 2 * mmax + 1];
             for m in -(mmax as i64)..=(mmax as i64) {
                 let idx = m.rem_euclid(ntheta as i64) as usize;

@@ -7,6 +7,7 @@
 //! fit is then one matrix–vector product.
 
 use crate::optics::zernike::{basis_values, num_terms};
+use nalgebra::DMatrix;
 
 /// Gauss–Legendre nodes and weights on [0, 1].
 pub fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
@@ -37,46 +38,6 @@ pub fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
     out
 }
 
-/// Cholesky solve of the symmetric positive definite `a` (n×n, row-major) for several
-/// right-hand sides `b` (n×k, row-major), in place. Returns false if `a` is not SPD.
-fn cholesky_solve(a: &mut [f64], n: usize, b: &mut [f64], k: usize) -> bool {
-    for j in 0..n {
-        let mut d = a[j * n + j];
-        for p in 0..j {
-            d -= a[j * n + p] * a[j * n + p];
-        }
-        if d.is_nan() || d <= 0.0 {
-            return false;
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for p in 0..j {
-                s -= a[i * n + p] * a[j * n + p];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    for c in 0..k {
-        for i in 0..n {
-            let mut s = b[i * k + c];
-            for p in 0..i {
-                s -= a[i * n + p] * b[p * k + c];
-            }
-            b[i * k + c] = s / a[i * n + i];
-        }
-        for i in (0..n).rev() {
-            let mut s = b[i * k + c];
-            for p in i + 1..n {
-                s -= a[p * n + i] * b[p * k + c];
-            }
-            b[i * k + c] = s / a[i * n + i];
-        }
-    }
-    true
-}
-
 /// Weighted least-squares operator for `points` (unit disk) and `weights`: a terms × points
 /// row-major matrix P with c = P·w. `None` if the points do not determine every term.
 pub fn fit_operator(order: u32, points: &[[f64; 2]], weights: &[f64]) -> Option<Vec<f64>> {
@@ -90,27 +51,21 @@ pub fn fit_operator(order: u32, points: &[[f64; 2]], weights: &[f64]) -> Option<
             b[j * np + i] = z[j];
         }
     }
-    let mut a = vec![0.0; nt * nt];
+    // BᵀWB; the factorisation reads its lower triangle only
+    let mut a = DMatrix::<f64>::zeros(nt, nt);
     for j in 0..nt {
         for l in 0..=j {
-            let s: f64 = (0..np)
+            a[(j, l)] = (0..np)
                 .map(|i| b[j * np + i] * b[l * np + i] * weights[i])
                 .sum();
-            a[j * nt + l] = s;
-            a[l * nt + j] = s;
         }
     }
-    let mut rhs = vec![0.0; nt * np];
-    for j in 0..nt {
-        for i in 0..np {
-            rhs[j * np + i] = b[j * np + i] * weights[i];
-        }
-    }
-    if cholesky_solve(&mut a, nt, &mut rhs, np) {
-        Some(rhs)
-    } else {
-        None
-    }
+    // None when BᵀWB is not positive definite: the points do not determine every term
+    let chol = a.cholesky()?;
+    let mut rhs = DMatrix::from_fn(nt, np, |j, i| b[j * np + i] * weights[i]);
+    chol.solve_mut(&mut rhs);
+    // nalgebra stores column-major; the operator is row-major
+    Some(rhs.transpose().as_slice().to_vec())
 }
 
 /// A fixed pupil sampling with its fit operator.

@@ -15,7 +15,7 @@
 
 use std::path::Path;
 
-use crate::image_io::{ImageGray, ImageRgba};
+use crate::image_types::{ImageGray, ImageRgba};
 use crate::{Error, Result};
 
 /// Blender passes (and similar) that hold one value per pixel but are not view-axis depth:

@@ -9,7 +9,7 @@ pub mod picture;
 
 use std::path::{Path, PathBuf};
 
-use crate::image_io::ImageRgba;
+use crate::image_types::ImageRgba;
 use crate::{Error, Result};
 
 pub use depth::DepthReport;

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::image_io::ImageRgba;
+use crate::image_types::ImageRgba;
 use crate::{Error, Result};
 
 /// Luminance of white (cd/m²) when none is given: the reference display of the sRGB standard

@@ -12,9 +12,10 @@
 //! Piston, tilt and defocus are not put into β: piston is a global phase, tilt is an exact
 //! translation of the PSF and defocus is carried by f (see [`super::psf`]).
 
-use super::quadrature::{fejer1_01, fft_in_place};
+use super::quadrature::fejer1_01;
 use super::zernike::{num_terms, order_for_len, osa_index, radial_family};
 use num_complex::Complex64;
+use rustfft::FftPlanner;
 use std::f64::consts::PI;
 
 /// Stiles–Crawford amplitude apodisation. The directional sensitivity of the cones is usually
@@ -71,6 +72,9 @@ fn project(
     let nt = num_terms(degree);
     let mut beta = vec![Complex64::new(0.0, 0.0); nt];
     let mut ring = vec![Complex64::new(0.0, 0.0); m_theta];
+    // one plan for every ring; rustfft's forward transform is Σ_k x_k e^{−2πi jk/M}, unscaled
+    let fft = FftPlanner::<f64>::new().plan_fft_forward(m_theta);
+    let mut scratch = vec![Complex64::new(0.0, 0.0); fft.get_inplace_scratch_len()];
     let mut rad = vec![0.0; degree.max(aorder) as usize / 2 + 1];
     let k2pi = 2.0 * PI / wavelength_um;
     // cos(μθ_k), sin(μθ_k) for the wavefront's azimuthal orders, shared by every ring
@@ -119,7 +123,7 @@ fn project(
             *slot = Complex64::from_polar(a, k2pi * wf);
         }
         // ring[m] = Σ_k P_k e^{−imθ_k}; P_m(ρ) = ring[m]/M (negative m wrap around).
-        fft_in_place(&mut ring);
+        fft.process_with_scratch(&mut ring, &mut scratch);
         let scale = w / m_theta as f64;
         for mu in 0..=degree {
             radial_family(degree, mu, rho, &mut rad);
@@ -208,5 +212,29 @@ pub fn beta_from_alpha(
             };
         }
         deg = (deg * 2).min(max_degree);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `project` reads ring[m] as Σ_k P_k e^{−imθ_k}: rustfft's forward transform, unscaled.
+    #[test]
+    fn forward_fft_is_the_unscaled_negative_exponent_dft() {
+        let n = 64;
+        let data: Vec<Complex64> = (0..n)
+            .map(|i| Complex64::new((i as f64 * 0.3).sin(), (i as f64).cos()))
+            .collect();
+        let mut f = data.clone();
+        FftPlanner::<f64>::new().plan_fft_forward(n).process(&mut f);
+        for (k, fk) in f.iter().enumerate() {
+            let mut s = Complex64::new(0.0, 0.0);
+            for (j, d) in data.iter().enumerate() {
+                let a = -2.0 * PI * (j * k) as f64 / n as f64;
+                s += d * Complex64::new(a.cos(), a.sin());
+            }
+            assert!((s - fk).norm() < 1e-12);
+        }
     }
 }

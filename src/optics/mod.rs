@@ -3,7 +3,7 @@
 //! - [`zernike`]: OSA/ANSI Zernike algebra (std only; compiled on its own by the eye model).
 //! - [`prescription`]: sphere / cylinder / axis and its second-order Zernike terms.
 //! - [`bessel`]: J_n and spherical j_k by Miller recurrence.
-//! - [`quadrature`]: Gauss–Legendre, Fejér (cosine-sampled pupil) rules, a small FFT.
+//! - [`quadrature`]: Gauss–Legendre, Fejér (cosine-sampled pupil) rules.
 //! - [`enz`]: V_n^m(r, f) (Bessel–Bessel series, power series, quadrature) and radial tables.
 //! - [`beta`]: ENZ pupil coefficients β from wavefront coefficients α.
 //! - [`fft_psf`]: the PSF by FFT of the sampled pupil function (large aberrations).

@@ -1,6 +1,5 @@
-//! Quadrature rules and a small FFT used by the ENZ engine and its tests.
+//! Quadrature rules used by the ENZ engine and its tests.
 
-use num_complex::Complex64;
 use std::f64::consts::PI;
 
 /// Gauss–Legendre nodes and weights mapped to [0, 1], nodes ascending. Exact for polynomials
@@ -61,46 +60,6 @@ pub fn fejer1_01(k: usize) -> (Vec<f64>, Vec<f64>) {
     (ts, ws)
 }
 
-/// In-place radix-2 complex FFT, forward sign exp(−2πi jk/N). `data.len()` must be a power of two.
-pub fn fft_in_place(data: &mut [Complex64]) {
-    let n = data.len();
-    assert!(n.is_power_of_two(), "fft length must be a power of two");
-    let mut j = 0;
-    for i in 1..n {
-        let mut bit = n >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            data.swap(i, j);
-        }
-    }
-    let mut len = 2;
-    while len <= n {
-        let ang = -2.0 * PI / len as f64;
-        let wlen = Complex64::new(ang.cos(), ang.sin());
-        for start in (0..n).step_by(len) {
-            let mut w = Complex64::new(1.0, 0.0);
-            for k in 0..len / 2 {
-                let u = data[start + k];
-                let v = data[start + k + len / 2] * w;
-                data[start + k] = u + v;
-                data[start + k + len / 2] = u - v;
-                // Recompute the twiddle every 64 steps to keep rounding from accumulating.
-                if k % 64 == 63 {
-                    let a = ang * (k + 1) as f64;
-                    w = Complex64::new(a.cos(), a.sin());
-                } else {
-                    w *= wlen;
-                }
-            }
-        }
-        len <<= 1;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -121,24 +80,6 @@ mod tests {
         for d in 0..12 {
             let s: f64 = t.iter().zip(&w).map(|(t, w)| w * t.powi(d)).sum();
             assert!((s - 1.0 / (d as f64 + 1.0)).abs() < 1e-14, "d={d}");
-        }
-    }
-
-    #[test]
-    fn fft_matches_dft() {
-        let n = 64;
-        let data: Vec<Complex64> = (0..n)
-            .map(|i| Complex64::new((i as f64 * 0.3).sin(), (i as f64).cos()))
-            .collect();
-        let mut f = data.clone();
-        fft_in_place(&mut f);
-        for (k, fk) in f.iter().enumerate() {
-            let mut s = Complex64::new(0.0, 0.0);
-            for (j, d) in data.iter().enumerate() {
-                let a = -2.0 * PI * (j * k) as f64 / n as f64;
-                s += d * Complex64::new(a.cos(), a.sin());
-            }
-            assert!((s - fk).norm() < 1e-12);
         }
     }
 }
