@@ -340,7 +340,8 @@ fn the_depth_policy_counts_background_invalid_and_near_pixels() {
         .chain(&out[4..7])
         .all(|&d| d == f32::INFINITY));
     assert_eq!(report.clamped_near_px, 1);
-    assert!((out[7] - 1.0 / 49.875).abs() < 1e-8, "{}", out[7]);
+    // the default object axis's nearest sample (1/16 D steps from 0 D): 50 D
+    assert!((out[7] - 1.0 / 50.0).abs() < 1e-8, "{}", out[7]);
     assert_eq!(report.constant_m, None);
     let warnings = report.warnings();
     assert!(warnings
@@ -348,7 +349,7 @@ fn the_depth_policy_counts_background_invalid_and_near_pixels() {
         .any(|w| w.contains("3 pixel(s)") && w.contains("(4, 0)")));
     assert!(warnings
         .iter()
-        .any(|w| w.starts_with("1 pixel(s) nearer than 0.0201 m")));
+        .any(|w| w.starts_with("1 pixel(s) nearer than 0.0200 m")));
 
     // Half floats: 65504 is the background marker. --depth-scale converts units to metres
     // (centimetres here) after the background test on raw values.
