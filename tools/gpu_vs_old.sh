@@ -8,8 +8,8 @@
 #
 # Order (a run cut short keeps the most comparable rows): 1280×720 for primitives and colonnade
 # through the four preset eyes, new then old; 1920×1080 and 3840×2160 for the astigmatic and
-# keratoconic eyes; colonnade off axis at 1280×720; then level of detail by blur
-# (--merge-blur-per-block 2 --merge-levels 5) at every size. Summarise with
+# keratoconic eyes; colonnade off axis at 1280×720; then merged blocks up to 32×32, none wider than half
+# the blur (--merge-blur-per-block 2 --merge-levels 5) at every size. Summarise with
 # `tools/gpu_vs_old_table.py OUT_DIR`.
 #
 # Environment: FRAMES (timed frames, default 20), WARMUP (default 3), RUN_TIMEOUT_S (one run's

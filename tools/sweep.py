@@ -29,7 +29,7 @@ BINARY = os.path.join(ROOT, "target", "release", "ocular")
 SWEEP = [
     ("object samples", "--object-samples", ["9", "21", "41", "81"]),
     ("Rmax cap", "--rmax-cap", ["4", "8", "16", "64"]),
-    ("merge levels", "--merge-levels", ["0", "1", "2"]),
+    ("merge levels", "--merge-levels", ["0", "1", "2", "5"]),
     ("merge min radius", "--merge-min-radius", ["2", "5", "10"]),
     ("merge colour tolerance", "--merge-color-tolerance", ["0.02", "0.1", "0.3"]),
     ("tile size", "--tile-size", ["8", "16", "32"]),
