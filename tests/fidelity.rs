@@ -332,6 +332,48 @@ fn case2_a_point_before_a_distant_background_keeps_its_energy() {
 }
 
 // ---------------------------------------------------------------------------------------
+/// White point lights `distance_m` along the rays of `pixels`, on black at 1000 m.
+fn point_lights(
+    (w, h, fov): (usize, usize, f64),
+    pixels: &[(usize, usize)],
+    distance_m: f64,
+) -> (Vec<[f32; 4]>, Vec<f32>) {
+    let mut color = vec![[0.0f32, 0.0, 0.0, 1.0]; w * h];
+    let mut depth = vec![1000.0f32; w * h];
+    for &(x, y) in pixels {
+        color[y * w + x] = [1.0; 4];
+        depth[y * w + x] = axial(distance_m, x, y, w, h, fov);
+    }
+    (color, depth)
+}
+
+/// The spots through the healthy eye focused at infinity with a 6 mm pupil, and the seed
+/// paper's blend as the control (its geometry is the narrow field's scale everywhere).
+fn spots_and_paper_control(
+    ctx: &ocular::gpu::Context,
+    input: &FrameInput<'_>,
+    with_reference: bool,
+) -> (Rendered, Vec<[f32; 4]>) {
+    let state = EyeState {
+        focus_d: 0.0,
+        pupil_mm: 6.0,
+    };
+    let out = render(
+        ctx,
+        "healthy",
+        input,
+        state,
+        SplatSettings::default(),
+        with_reference,
+    );
+    let paper = SplatSettings {
+        blend: ocular::render::blend::BlendSettings::paper(),
+        ..SplatSettings::default()
+    };
+    let control = render(ctx, "healthy", input, state, paper, false).splat;
+    (out, control)
+}
+
 // Case 4: spots near the frame's edge grow with the pinhole's scale, in splat and reference.
 
 #[test]
@@ -345,30 +387,10 @@ fn case4_spots_grow_with_the_pinhole_scale_to_the_frame_edge() {
         .iter()
         .map(|a| (0.5 * w as f64 + focal * a.to_radians().tan() - 0.5).round() as usize)
         .collect();
-    let mut color = vec![[0.0f32, 0.0, 0.0, 1.0]; w * h];
-    let mut depth = vec![1000.0f32; w * h];
-    for &x in &columns {
-        color[cy * w + x] = [1.0; 4];
-        depth[cy * w + x] = axial(0.25, x, cy, w, h, fov);
-    }
+    let pixels: Vec<(usize, usize)> = columns.iter().map(|&x| (x, cy)).collect();
+    let (color, depth) = point_lights((w, h, fov), &pixels, 0.25);
     let input = one_layer((w, h, fov), &color, &depth);
-    let state = EyeState {
-        focus_d: 0.0,
-        pupil_mm: 6.0,
-    };
-    let out = render(
-        &ctx,
-        "healthy",
-        &input,
-        state,
-        SplatSettings::default(),
-        true,
-    );
-    let paper = SplatSettings {
-        blend: ocular::render::blend::BlendSettings::paper(),
-        ..SplatSettings::default()
-    };
-    let control = render(&ctx, "healthy", &input, state, paper, false).splat;
+    let (out, control) = spots_and_paper_control(&ctx, &input, true);
     let widths = |image: &[[f32; 4]], x: usize| common::spots::rms_widths(image, w, (x, cy), 36);
     for (name, image) in [
         ("splat", &out.splat),
@@ -898,30 +920,9 @@ fn case8_spots_to_the_corners_of_a_90_degree_field() {
             )
         })
         .collect();
-    let mut color = vec![[0.0f32, 0.0, 0.0, 1.0]; w * h];
-    let mut depth = vec![1000.0f32; w * h];
-    for &(x, y) in &pixels {
-        color[y * w + x] = [1.0; 4];
-        depth[y * w + x] = axial(0.1, x, y, w, h, fov);
-    }
+    let (color, depth) = point_lights((w, h, fov), &pixels, 0.1);
     let input = one_layer((w, h, fov), &color, &depth);
-    let state = EyeState {
-        focus_d: 0.0,
-        pupil_mm: 6.0,
-    };
-    let out = render(
-        &ctx,
-        "healthy",
-        &input,
-        state,
-        SplatSettings::default(),
-        false,
-    );
-    let paper = SplatSettings {
-        blend: ocular::render::blend::BlendSettings::paper(),
-        ..SplatSettings::default()
-    };
-    let control = render(&ctx, "healthy", &input, state, paper, false).splat;
+    let (out, control) = spots_and_paper_control(&ctx, &input, false);
     eprintln!(
         "case 8: {w}×{h} at {fov}° vertical (corners {:.1}° off axis), Rmax {} px",
         (norm / focal).atan().to_degrees(),

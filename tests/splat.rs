@@ -128,6 +128,26 @@ fn texture(x: u32, y: u32, seed: f32) -> [f32; 3] {
     ]
 }
 
+/// The PSF texture read at `points` (texel centres) against `wanted`: the worst error relative
+/// to max(|wanted|, 1). The probe is returned so that the caller drops it with its splatter.
+fn worst_texel_error(
+    ctx: &Context,
+    image: &ocular::gpu::Image,
+    sampler: &ocular::gpu::Sampler,
+    points: &[[f32; 3]],
+    wanted: &[[f32; 3]],
+) -> (f32, TextureProbe) {
+    let probe = TextureProbe::new(ctx).unwrap();
+    let samples = probe.sample(ctx, image, sampler, points).unwrap();
+    let mut worst = 0.0f32;
+    for (want, s) in wanted.iter().zip(&samples) {
+        for c in 0..3 {
+            worst = worst.max((want[c] - s[c]).abs() / want[c].abs().max(1.0));
+        }
+    }
+    (worst, probe)
+}
+
 #[test]
 fn psf_texture_matches_cpu_blend_of_four_grid_states() {
     let ctx = common::gpu();
@@ -202,14 +222,7 @@ fn psf_texture_matches_cpu_blend_of_four_grid_states() {
                 }
             }
         }
-        let probe = TextureProbe::new(&ctx).unwrap();
-        let samples = probe.sample(&ctx, image, sampler, &points).unwrap();
-        let mut worst = 0.0f32;
-        for (want, s) in wanted.iter().zip(&samples) {
-            for c in 0..3 {
-                worst = worst.max((want[c] - s[c]).abs() / want[c].abs().max(1.0));
-            }
-        }
+        let (worst, probe) = worst_texel_error(&ctx, image, sampler, &points, &wanted);
         eprintln!("{format:?}: worst relative texel error {worst:.2e}");
         assert!(worst < tolerance, "{format:?}: {worst}");
         drop((splatter, probe));
@@ -302,14 +315,7 @@ fn block_kernels_are_the_kernel_summed_over_the_block() {
         }
     }
     assert!(held >= 3 * 4, "{held} block kernels held");
-    let probe = TextureProbe::new(&ctx).unwrap();
-    let samples = probe.sample(&ctx, image, sampler, &points).unwrap();
-    let mut worst = 0.0f32;
-    for (want, s) in wanted.iter().zip(&samples) {
-        for c in 0..3 {
-            worst = worst.max((want[c] - s[c]).abs() / want[c].abs().max(1.0));
-        }
-    }
+    let (worst, probe) = worst_texel_error(&ctx, image, sampler, &points, &wanted);
     eprintln!("{held} block kernels: worst relative texel error {worst:.2e}");
     assert!(worst < 1e-5, "{worst}");
     drop((splatter, probe));

@@ -370,14 +370,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     }
     let gap_d = splat.blend.group_tolerance_d;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
-    let input = FrameInput {
-        width,
-        height,
-        color: &frame.color,
-        depth_m: &frame.depth_m,
-        fov_y_deg: screen.fov_y_deg,
-        hidden_layers: &[],
-    };
+    let input = frame.input(screen.fov_y_deg);
     let runs = if args.baseline { 2 } else { 1 };
     let bar = frame_bar((runs * (args.warmup + args.frames)) as u64);
     let scene_state = scene.at_time(0.0);

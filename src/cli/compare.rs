@@ -178,14 +178,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     if let Some(bin) = args.truth_bin_d {
         renderer.reference_dioptre_bin_d = bin;
     }
-    let input = FrameInput {
-        width,
-        height,
-        color: &frame.color,
-        depth_m: &frame.depth_m,
-        fov_y_deg: screen.fov_y_deg,
-        hidden_layers: &[],
-    };
+    let input = frame.input(screen.fov_y_deg);
     let at = Frames {
         ctx: &ctx,
         scene: &scene,

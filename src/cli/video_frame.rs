@@ -7,7 +7,6 @@ use crate::gpu::Context;
 use crate::image_io::ImageRgba;
 use crate::render::frame::{EyeState, FrameRenderer, Method};
 use crate::render::frame_plan::{self, FrameView, PupilAsked, PupilFallback, PupilModel, SceneEye};
-use crate::render::splat::FrameInput;
 use crate::render::{Frame, Rasterizer};
 use crate::scene::FrameState;
 use crate::Result;
@@ -81,14 +80,7 @@ pub(super) fn render_panels(
     for (renderer, magnification) in renderers.iter_mut().zip(magnifications) {
         let out = match (&measured, magnification) {
             (Some(frame), None) if layers == 1 => {
-                let input = FrameInput {
-                    width: size.0,
-                    height: size.1,
-                    color: &frame.color,
-                    depth_m: &frame.depth_m,
-                    fov_y_deg: state.camera.fov_y_deg,
-                    hidden_layers: &[],
-                };
+                let input = frame.input(state.camera.fov_y_deg);
                 renderer.render(&input, eye_state, Method::Splat)?
             }
             _ => {

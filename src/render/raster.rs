@@ -52,6 +52,18 @@ impl Frame {
     pub fn depth_image(&self) -> ImageGray {
         ImageGray::new(self.width, self.height, self.depth_m.clone())
     }
+
+    /// The frame as splat's single-layer input, seen through a `fov_y_deg` vertical field.
+    pub fn input(&self, fov_y_deg: f64) -> crate::render::splat::FrameInput<'_> {
+        crate::render::splat::FrameInput {
+            width: self.width,
+            height: self.height,
+            color: &self.color,
+            depth_m: &self.depth_m,
+            fov_y_deg,
+            hidden_layers: &[],
+        }
+    }
 }
 
 #[repr(C)]
