@@ -21,7 +21,7 @@ const NO_MERGE: MergeSettings = MergeSettings {
     levels: 0,
     blur_per_block: 0.0,
     min_radius_px: 5.0,
-    color_tolerance: 0.1,
+    color_error: MergeSettings::DEFAULT_COLOR_ERROR,
     dioptre_tolerance: 0.01,
 };
 

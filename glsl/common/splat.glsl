@@ -36,7 +36,7 @@ layout(std140, binding = FRAME_BINDING) uniform FrameUniform {
     float dioptre_min;
     float dioptre_step;
     float merge_min_radius;
-    float merge_color_tolerance;
+    float merge_color_error;
     float merge_dioptre_tolerance;
     float focal_px;        // (H/2)/tan(fov_y/2)
     float group_tolerance_d;

@@ -167,8 +167,8 @@ pub struct SplatArgs {
     #[arg(long, default_value_t = crate::render::splat::MergeSettings::DEFAULT_LEVELS)]
     pub merge_levels: u32,
     /// Level of detail by blur: merge a block of side s only where every kernel in it is at
-    /// least this many times s in radius (0 = any side, the seed paper's rule); colours and
-    /// depths must also agree within their tolerances per pixel of blur.
+    /// least this many times s in radius (0 = any side, the seed paper's rule); its colours
+    /// must also agree within --merge-color-error and its depths within their tolerance.
     #[arg(
         long,
         value_name = "K",
@@ -184,9 +184,17 @@ pub struct SplatArgs {
         allow_hyphen_values = true
     )]
     pub merge_min_radius: f32,
-    /// Largest colour difference inside a merged block, per pixel of blur radius.
-    #[arg(long, default_value_t = 0.10, allow_hyphen_values = true)]
-    pub merge_color_tolerance: f32,
+    /// The most that averaging one merged block's colours may change any pixel (linear colour
+    /// units; default one 8-bit step). A block of side s under blur radius r merges when its
+    /// parts' colours differ by at most 4π·E·(r/s)²: the wider the blur against the block,
+    /// the larger the difference that cannot show.
+    #[arg(
+        long,
+        value_name = "E",
+        default_value_t = crate::render::splat::MergeSettings::DEFAULT_COLOR_ERROR,
+        allow_hyphen_values = true
+    )]
+    pub merge_color_error: f32,
     #[command(flatten)]
     pub blend: BlendArgs,
     /// Aberrations across the visual field: each pixel gets the PSF of the eye traced for its
@@ -206,7 +214,7 @@ impl SplatArgs {
                 levels: self.merge_levels,
                 blur_per_block: self.merge_blur_per_block,
                 min_radius_px: self.merge_min_radius,
-                color_tolerance: self.merge_color_tolerance,
+                color_error: self.merge_color_error,
                 ..crate::render::splat::MergeSettings::default()
             },
             blend: self.blend.settings(),

@@ -127,6 +127,9 @@ pub fn merge_level(
             if hi - lo > frame.group_tolerance_d {
                 continue;
             }
+            // 4π·ε·(r/s)², in merge.comp's order of operations.
+            let blur_per_side = r_min / size as f32;
+            let color_bound = 12.566371f32 * settings.color_error * blur_per_side * blur_per_side;
             let mut ok = true;
             let mut spread = 0.0f32;
             for a in 0..4 {
@@ -134,7 +137,7 @@ pub fn merge_level(
                     let dc = (0..3)
                         .map(|c| (f[a].color[c] - f[b].color[c]).abs())
                         .fold(0.0, f32::max);
-                    if dc >= settings.color_tolerance * r_min {
+                    if dc > color_bound {
                         ok = false;
                     }
                     spread += (f[a].index - f[b].index).abs() * frame.dioptre_step;

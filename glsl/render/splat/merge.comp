@@ -3,8 +3,8 @@
 // fragment takes the block's top-left slot, the others are marked merged away (size 0).
 // One dispatch per block size (`MergePush` in src/render/splat/merge.rs): 2 merges 2×2 single
 // pixels, 4 merges 2×2 already-merged 2×2 blocks, and so on up to 32. Thresholds scale with
-// the block's smallest blur radius: the more blur, the less a small difference in colour or
-// dioptre can show.
+// the block's smallest blur radius: the more blur, the less a difference in colour or dioptre
+// can show.
 #extension GL_GOOGLE_include_directive : require
 #define FRAME_BINDING 5
 #include "splat.glsl"
@@ -64,10 +64,13 @@ void main() {
     // their kernel (the block reads the kernel summed over its pixels, below), so what merging
     // averages is their colours and depths: (1) the block is no wider than the blur allows,
     // s ≤ r / k (`blur_per_block`, 0: any side) and r at least the minimum radius;
-    // (2) colours within the tolerance per pixel of blur (the seed paper's rule: under a wide
-    // kernel a colour difference spreads thin); (3) the depths' summed spread within its
-    // tolerance per pixel of blur, and the whole block in one depth group of the blend, so the
-    // merged fragment joins the group its pixels would have.
+    // (2) colours: a kernel's rim (height about 1/(πr²)) crossing the block splits it, and the
+    // part inside carries its own colour, not the block's mean; with children whose colours
+    // differ by Δc that misplaces about Δc·s²/4 of colour, so the pixel moves by about
+    // Δc·(s/r)²/(4π). A smooth gradient cancels around the rim; a step does not. The block
+    // merges when that is at most the error budget ε (`merge_color_error`). (3) the depths'
+    // summed spread within its tolerance per pixel of blur, and the whole block in one depth
+    // group of the blend, so the merged fragment joins the group its pixels would have.
     if (r_min < max(frame.merge_min_radius, push.blur_per_block * float(size))) {
         return;
     }
@@ -80,11 +83,14 @@ void main() {
     if (hi - lo > frame.group_tolerance_d) {
         return;
     }
+    float blur_per_side = r_min / float(size);
+    // 4π·ε·(r/s)²
+    float color_bound = 12.566371 * frame.merge_color_error * blur_per_side * blur_per_side;
     float dioptre_spread = 0.0;
     for (int a = 0; a < 4; a++) {
         for (int b = a + 1; b < 4; b++) {
             vec3 dc = abs(f[a].color - f[b].color);
-            if (max3(dc) >= frame.merge_color_tolerance * r_min) {
+            if (max3(dc) > color_bound) {
                 return;
             }
             dioptre_spread += abs(f[a].index - f[b].index) * frame.dioptre_step;

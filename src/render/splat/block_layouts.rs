@@ -36,7 +36,7 @@ fn frame_uniform() -> BlockLayout {
         dioptre_min,
         dioptre_step,
         merge_min_radius,
-        merge_color_tolerance,
+        merge_color_error,
         merge_dioptre_tolerance,
         focal_px,
         group_tolerance_d,

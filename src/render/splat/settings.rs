@@ -19,16 +19,27 @@ pub struct MergeSettings {
     pub blur_per_block: f32,
     /// Smallest blur radius (px, over the block and the channels) for a block to merge.
     pub min_radius_px: f32,
-    /// Largest colour difference between two fragments of a block, per pixel of blur radius.
-    pub color_tolerance: f32,
+    /// The most, in linear colour units, that averaging one block's colours may change any
+    /// pixel it reaches. Under a kernel of radius r the block's pixels keep their kernel and
+    /// only their colours are averaged; a PSF's sharp rim crossing a block of side s whose
+    /// halves differ by Δc misplaces about Δc·s²/4 pixels' worth of colour difference at a
+    /// height of 1/(πr²), so a block merges when Δc ≤ 4π·ε·(r/s)². A colour gradient cancels
+    /// around the rim; a step, or a texture whose period is near s, does not.
+    pub color_error: f32,
     /// Largest summed pairwise dioptre difference in a block, per pair and pixel of blur.
     pub dioptre_tolerance: f32,
 }
 
 impl MergeSettings {
-    /// Block sides up to 32×32, each no wider than the blur's radius.
+    /// 2×2 blocks only: larger blocks cost quality on textures whose period is near the block
+    /// side (a sinusoid plane loses 2–12 dB with 5 levels; docs/validation.md, "Merging").
     pub const DEFAULT_LEVELS: u32 = 1;
     pub const DEFAULT_BLUR_PER_BLOCK: f32 = 1.0;
+    /// One 8-bit step. The bound holds per block, and the blocks along a kernel's rim add: a
+    /// texture whose period is near the block side meets it on all of them (a sinusoid plane
+    /// under a 12 px blur, merged up to 32×32, falls from 57 to 55 dB at 1/255 and to 33 dB
+    /// at 1/16; docs/validation.md, "Merging").
+    pub const DEFAULT_COLOR_ERROR: f32 = 1.0 / 255.0;
 }
 
 impl Default for MergeSettings {
@@ -38,7 +49,7 @@ impl Default for MergeSettings {
             levels: MergeSettings::DEFAULT_LEVELS,
             blur_per_block: MergeSettings::DEFAULT_BLUR_PER_BLOCK,
             min_radius_px: 5.0,
-            color_tolerance: 0.10,
+            color_error: MergeSettings::DEFAULT_COLOR_ERROR,
             dioptre_tolerance: 0.01,
         }
     }
@@ -143,7 +154,7 @@ impl SplatSettings {
             ));
         }
         if !(self.merge.min_radius_px >= 0.0
-            && self.merge.color_tolerance >= 0.0
+            && self.merge.color_error >= 0.0
             && self.merge.dioptre_tolerance >= 0.0)
         {
             return Err("merge thresholds must be non-negative numbers".into());
