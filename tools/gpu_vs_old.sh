@@ -7,9 +7,9 @@
 #   tools/gpu_vs_old.sh NEW_BINARY OLD_BINARY OUT_DIR
 #
 # Order (a run cut short keeps the most comparable rows): 1280×720 for primitives and colonnade
-# through the four preset eyes, new then old; 1920×1080 and 3840×2160 for the astigmatic and
-# keratoconic eyes; colonnade off axis at 1280×720; then merged blocks up to 32×32, none wider than half
-# the blur (--merge-blur-per-block 2 --merge-levels 5) at every size. Summarise with
+# through the four preset eyes, new, new with 2×2 merging only (`--merge-levels 1`, the
+# previous default) and old; 1920×1080 and 3840×2160 for the astigmatic and keratoconic eyes,
+# new and old; colonnade off axis at 1280×720, new and old. Summarise with
 # `tools/gpu_vs_old_table.py OUT_DIR`.
 #
 # Environment: FRAMES (timed frames, default 20), WARMUP (default 3), RUN_TIMEOUT_S (one run's
@@ -56,24 +56,21 @@ pair() {
 
 for scene in primitives colonnade; do
     for eye in healthy myopia astigmatism keratoconus; do
-        pair "${scene}_${eye}_1280x720" --scene "$scene" --eye "$eye" --size 1280x720
-    done
-done
-for size in 1920x1080 3840x2160; do
-    for scene in primitives colonnade; do
-        for eye in astigmatism keratoconus; do
-            pair "${scene}_${eye}_${size}" --scene "$scene" --eye "$eye" --size "$size"
-        done
+        tag="${scene}_${eye}_1280x720"
+        run "${tag}_new" "$new" --scene "$scene" --eye "$eye" --size 1280x720
+        run "${tag}_l1" "$new" --scene "$scene" --eye "$eye" --size 1280x720 --merge-levels 1
+        run "${tag}_old" "$old" --scene "$scene" --eye "$eye" --size 1280x720
     done
 done
 for eye in healthy astigmatism; do
     pair "colonnade_${eye}_1280x720_off-axis" --scene colonnade --eye "$eye" --size 1280x720 \
         --off-axis
 done
-for size in 1280x720 1920x1080 3840x2160; do
-    for eye in astigmatism keratoconus; do
-        run "colonnade_${eye}_${size}_lod2" "$new" --scene colonnade --eye "$eye" --size "$size" \
-            --merge-blur-per-block 2 --merge-levels 5
+for size in 1920x1080 3840x2160; do
+    for scene in primitives colonnade; do
+        for eye in astigmatism keratoconus; do
+            pair "${scene}_${eye}_${size}" --scene "$scene" --eye "$eye" --size "$size"
+        done
     done
 done
 echo "gpu_vs_old: $((SECONDS - start)) s"

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The table of tools/gpu_vs_old.sh's runs: per scene, eye and size, the new engine's GPU time
 split into the draw (raster, depth resolve) and the splat passes (everything else), its wall
-time, the old engine's, and their ratios; the level-of-detail runs beside the default.
+time, the old engine's, and their ratios; beside them the new engine with 2×2 merging only.
 
     tools/gpu_vs_old_table.py OUT_DIR
 
@@ -35,22 +35,25 @@ def fmt_entries(n):
 def main():
     folder = sys.argv[1]
     devices = open(os.path.join(folder, "devices.txt")).read().strip().splitlines()
-    print(f"device: {devices[0] if devices else '?'}\n")
+    # `ocular devices` lists a header, then one line per device, the default marked with '*'.
+    used = [d.lstrip("* ").strip() for d in devices if d.startswith("*") and "used by" not in d]
+    print(f"device: {used[0] if used else '?'}\n")
     print("| scene | eye | size | new: draw + splat ms | new wall ms | old: draw + splat ms "
           "| old wall ms | splat, old ÷ new | entries new / old | evaluations per pixel | "
-          "LOD K=2: splat ms, evaluations per pixel |")
+          "2×2 merging only: splat ms, evaluations per pixel |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     names = sorted({f[:-9] for f in os.listdir(folder) if f.endswith("_new.json")},
                    key=lambda s: (s.count("off-axis"), int(s.split("_")[2].split("x")[0]), s))
     for tag in names:
         new = load(folder, tag + "_new")
         old = load(folder, tag + "_old")
-        lod = load(folder, tag + "_lod2") if "off-axis" not in tag else None
+        lod = load(folder, tag + "_l1")
         scene, eye, size = tag.split("_")[:3]
+        size = size.replace("x", "×")
         if "off-axis" in tag:
             size += " off axis"
         nd, ns = split(new)
-        row = [scene, eye, size.replace("x", "×"), f"{nd:.2f} + {ns:.2f}",
+        row = [scene, eye, size, f"{nd:.2f} + {ns:.2f}",
                f"{new['wall_ms_per_frame']['mean_ms']:.1f}"]
         if old:
             od, os_ = split(old)
