@@ -184,10 +184,11 @@ pub struct SplatArgs {
         allow_hyphen_values = true
     )]
     pub merge_min_radius: f32,
-    /// The most that averaging one merged block's colours may change any pixel (linear colour
-    /// units; default one 8-bit step). A block of side s under blur radius r merges when its
-    /// parts' colours differ by at most 4π·E·(r/s)²: the wider the blur against the block,
-    /// the larger the difference that cannot show.
+    /// The most that averaging one merged block's colours may change any pixel, block by block
+    /// (linear colour units; default 1/1020, a quarter of an 8-bit step, since the blocks
+    /// along a kernel's rim add). A block of side s under blur radius r merges when its parts'
+    /// colours differ by at most 4π·E·(r/s)²: the wider the blur against the block, the
+    /// larger the difference that cannot show.
     #[arg(
         long,
         value_name = "E",

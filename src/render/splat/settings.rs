@@ -31,15 +31,14 @@ pub struct MergeSettings {
 }
 
 impl MergeSettings {
-    /// 2×2 blocks only: larger blocks cost quality on textures whose period is near the block
-    /// side (a sinusoid plane loses 2–12 dB with 5 levels; docs/validation.md, "Merging").
-    pub const DEFAULT_LEVELS: u32 = 1;
+    /// Blocks up to 32×32, each no wider than the blur's radius, where colours allow.
+    pub const DEFAULT_LEVELS: u32 = 5;
     pub const DEFAULT_BLUR_PER_BLOCK: f32 = 1.0;
-    /// One 8-bit step. The bound holds per block, and the blocks along a kernel's rim add: a
-    /// texture whose period is near the block side meets it on all of them (a sinusoid plane
-    /// under a 12 px blur, merged up to 32×32, falls from 57 to 55 dB at 1/255 and to 33 dB
-    /// at 1/16; docs/validation.md, "Merging").
-    pub const DEFAULT_COLOR_ERROR: f32 = 1.0 / 255.0;
+    /// A quarter of an 8-bit step. The bound holds per block, and the blocks along a kernel's
+    /// rim add: on a texture whose period is near the block side they all meet it (a sinusoid
+    /// plane under a 12–19 px blur, merged up to 32×32, loses 2–12 dB at 1/255 and 24 dB at
+    /// 1/16; at 1/1020 it loses nothing; docs/validation.md, "Merging").
+    pub const DEFAULT_COLOR_ERROR: f32 = 1.0 / 1020.0;
 }
 
 impl Default for MergeSettings {
