@@ -388,10 +388,7 @@ impl<'a> Recorder<'a> {
             bytes.len() as u64,
             super::Residency::Upload,
         )?;
-        staging
-            .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")[..bytes.len()]
-            .copy_from_slice(bytes);
+        staging.write_mapped(0, bytes)?;
         self.copy_buffer(&staging, dst, bytes.len() as u64);
         self.keep_alive.push(staging);
         Ok(())

@@ -506,15 +506,11 @@ impl Rasterizer {
             Ok(())
         })?;
         let pixels = width as usize * height as usize;
-        fn mapped(b: &Buffer, bytes: usize) -> &[u8] {
-            &b.mapped_bytes()
-                .expect("read-back buffers are host-visible")[..bytes]
-        }
         Ok(Frame {
             width,
             height,
-            color: bytemuck::pod_collect_to_vec(mapped(color_readback, pixels * 16)),
-            depth_m: bytemuck::pod_collect_to_vec(mapped(depth_readback, pixels * 4)),
+            color: color_readback.read_mapped(0, pixels)?,
+            depth_m: depth_readback.read_mapped(0, pixels)?,
             timings,
         })
     }
@@ -583,9 +579,7 @@ impl Rasterizer {
             uniform.ambient[3] = gap_d;
         }
         self.uniforms
-            .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")[..std::mem::size_of::<FrameUniform>()]
-            .copy_from_slice(bytemuck::bytes_of(&uniform));
+            .write_mapped(0, std::slice::from_ref(&uniform))?;
         Ok(())
     }
 

@@ -177,11 +177,13 @@ impl Source<'_, '_> {
             });
         }
         let staging = frame.staging.as_mut().expect("made above");
-        write_mapped_at(&mut staging.color, 0, input.color);
-        write_mapped_at(&mut staging.depth, 0, input.depth_m);
+        staging.color.write_mapped(0, input.color)?;
+        staging.depth.write_mapped(0, input.depth_m)?;
         for (k, layer) in input.hidden_layers.iter().enumerate() {
-            write_mapped_at(&mut staging.color, (k + 1) * pixels, layer.color);
-            write_mapped_at(&mut staging.depth, (k + 1) * pixels, layer.depth_m);
+            staging.color.write_mapped((k + 1) * pixels, layer.color)?;
+            staging
+                .depth
+                .write_mapped((k + 1) * pixels, layer.depth_m)?;
         }
         Ok((pixels * 20 * frame.layers as usize) as u64)
     }
@@ -230,14 +232,4 @@ impl Source<'_, '_> {
             }
         }
     }
-}
-
-/// Writes `data` into a mapped buffer starting at element `offset` (elements of `T`).
-pub(super) fn write_mapped_at<T: bytemuck::Pod>(buffer: &mut Buffer, offset: usize, data: &[T]) {
-    let size = std::mem::size_of::<T>();
-    let bytes: &[u8] = bytemuck::cast_slice(data);
-    buffer
-        .mapped_bytes_mut()
-        .expect("upload buffers are host-visible")[offset * size..offset * size + bytes.len()]
-        .copy_from_slice(bytes);
 }

@@ -325,9 +325,9 @@ impl Splatter {
             .collect();
         // Inputs and radii go through persistent mapped buffers: no allocation per frame.
         let input_bytes = source.stage(&ctx, self.frame.as_mut().expect("ensured above"))?;
-        input::write_mapped_at(&mut self.radii_staging, 0, &radii);
+        self.radii_staging.write_mapped(0, &radii)?;
         let table = self.field_table.contents(self.nodes(), &blend);
-        input::write_mapped_at(&mut self.field_table.staging, 0, &table);
+        self.field_table.staging.write_mapped(0, &table)?;
         let projection = crate::render::projection::Projection {
             width: w,
             height: h,
@@ -340,7 +340,9 @@ impl Splatter {
         // Through the persistent mapping: submissions complete before `submit` returns, so no
         // earlier frame still reads it.
         let frame_mut = self.frame.as_mut().expect("ensured above");
-        input::write_mapped_at(&mut frame_mut.uniform, 0, std::slice::from_ref(&params));
+        frame_mut
+            .uniform
+            .write_mapped(0, std::slice::from_ref(&params))?;
         let upload_bytes =
             input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16 + FRAME_UNIFORM_BYTES;
         let frame = self.frame.as_ref().expect("ensured above");
@@ -376,7 +378,7 @@ impl Splatter {
                 Ok(())
             })?;
             submissions += 1;
-            let planned = read_band_header(&frame.readback_lists, header_at);
+            let planned = read_band_header(&frame.readback_lists, header_at)?;
             if planned.complete() {
                 self.texture_blend = Some(blend);
                 self.last_lists = Some((u64::from(planned.total_entries), planned.bands));
@@ -396,7 +398,7 @@ impl Splatter {
                     readback_bytes: output_bytes + bands::BAND_TABLE_HEADER_BYTES,
                     psf_texture_bytes: self.psf_texture_bytes(),
                 };
-                let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
+                let color: Vec<[f32; 4]> = frame.readback_color.read_mapped_all()?;
                 check_every_pixel_written(&color, w as usize)?;
                 return Ok(SplatOutput {
                     color,
@@ -431,7 +433,7 @@ impl Splatter {
             Ok(())
         })?;
         submissions += 1;
-        let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
+        let sizes: Vec<u32> = frame.readback_lists.read_mapped_all()?;
         let counts = sizes[..tiles as usize].to_vec();
         let live = u64::from(sizes[tiles as usize]);
         let offsets = sizes[tiles as usize + 1..2 * (tiles as usize + 1)].to_vec();
@@ -469,7 +471,7 @@ impl Splatter {
             Ok(())
         })?;
         submissions += 1;
-        let planned = read_band_header(&frame.readback_lists, header_at);
+        let planned = read_band_header(&frame.readback_lists, header_at)?;
         if !planned.complete() || planned.bands != slots {
             return Err(GpuError::Usage {
                 pass: "band plan".into(),
@@ -483,7 +485,7 @@ impl Splatter {
         timings.extend(band_timings);
         self.texture_blend = Some(blend);
         self.last_lists = Some((total, slots));
-        let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
+        let color: Vec<[f32; 4]> = frame.readback_color.read_mapped_all()?;
         check_every_pixel_written(&color, w as usize)?;
         let stats = SplatStats {
             fragments: pixels as u64,
@@ -732,14 +734,10 @@ impl Splatter {
 }
 
 /// The band table's header from the list-sizes read-back.
-fn read_band_header(readback: &Buffer, at: u64) -> PlannedBands {
-    let bytes = readback
-        .mapped_bytes()
-        .expect("read-back buffers are host-visible");
-    let at = at as usize;
-    let words: Vec<u32> =
-        bytemuck::pod_collect_to_vec(&bytes[at..at + bands::BAND_TABLE_HEADER_BYTES as usize]);
-    PlannedBands::from_header(&words)
+fn read_band_header(readback: &Buffer, at: u64) -> crate::gpu::GpuResult<PlannedBands> {
+    let words = readback
+        .read_mapped::<u32>(at as usize / 4, bands::BAND_TABLE_HEADER_BYTES as usize / 4)?;
+    Ok(PlannedBands::from_header(&words))
 }
 
 /// Entries a list buffer holds.
@@ -762,15 +760,6 @@ fn check_every_pixel_written(color: &[[f32; 4]], width: usize) -> crate::gpu::Gp
         x: first % width.max(1),
         y: first / width.max(1),
     })
-}
-
-/// The contents of a host-visible read-back buffer.
-fn read_mapped<T: bytemuck::Pod>(buffer: &Buffer) -> Vec<T> {
-    let bytes = buffer
-        .mapped_bytes()
-        .expect("read-back buffers are host-visible");
-    let n = bytes.len() / std::mem::size_of::<T>();
-    bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<T>()])
 }
 
 /// Sums the timings of passes that ran once per band, keeping first-seen order.
