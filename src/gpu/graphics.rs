@@ -96,7 +96,8 @@ pub struct GraphicsPipelineBuilder<'a> {
     fragment_spirv: &'a [u8],
     vertex_stride: u32,
     attributes: Vec<VertexAttribute>,
-    kinds: Vec<BindingKind>,
+    /// Binding kinds the pass declares, if it does (checked against the shaders).
+    kinds: Option<Vec<BindingKind>>,
     push_constant_bytes: u32,
     colors: Vec<ColorTarget>,
     depth: Option<(TexelFormat, DepthCompare)>,
@@ -134,7 +135,7 @@ impl GraphicsPipeline {
             fragment_spirv,
             vertex_stride: 0,
             attributes: Vec::new(),
-            kinds: Vec::new(),
+            kinds: None,
             push_constant_bytes: 0,
             colors: Vec::new(),
             depth: None,
@@ -149,6 +150,12 @@ impl GraphicsPipeline {
 
     pub fn samples(&self) -> u32 {
         self.samples
+    }
+
+    /// Starts binding a draw's resources by their names in the shaders; `finish` gives the
+    /// list `draw` and `draw_indexed` take.
+    pub fn bind(&self) -> super::bind::NamedBindings<'_> {
+        super::bind::NamedBindings::new(&self.name, &self.layout)
     }
 
     pub(crate) fn parts(&self) -> PipelineParts<'_> {
@@ -289,9 +296,11 @@ impl<'a> GraphicsPipelineBuilder<'a> {
         self
     }
 
-    /// Declares bindings 0, 1, 2, … of set 0, visible to both shader stages.
+    /// Optional: declares bindings 0, 1, 2, … of set 0, to be checked against the shaders
+    /// when the pipeline is built. Without it the layout is the shaders' (both stages see
+    /// every binding; draws bind by name).
     pub fn bindings(mut self, kinds: &[BindingKind]) -> Self {
-        self.kinds = kinds.to_vec();
+        self.kinds = Some(kinds.to_vec());
         self
     }
 
@@ -356,7 +365,7 @@ impl<'a> GraphicsPipelineBuilder<'a> {
         let layout = Layout::new(
             &shared,
             self.name,
-            &self.kinds,
+            self.kinds.as_deref(),
             &[],
             self.push_constant_bytes,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,

@@ -3,6 +3,7 @@
 //! completion, so resources can be dropped in any order.
 
 mod access;
+mod bind;
 mod buffer;
 mod commands;
 mod context;
@@ -15,6 +16,7 @@ mod render_pass;
 mod submit_slot;
 pub mod texture_probe;
 
+pub use bind::{Bindable, Dispatch, NamedBindings};
 pub use buffer::{Buffer, Residency};
 pub use commands::{PassTime, Recorder, Timings};
 pub use context::{
