@@ -26,6 +26,13 @@ pub(crate) struct BandPush {
     pub entry_capacity: u32,
 }
 
+/// One band slot as the list passes record it: its push constants and the list buffer.
+#[derive(Clone, Copy)]
+pub(super) struct BandSlot<'a> {
+    pub push: BandPush,
+    pub entries: &'a crate::gpu::Buffer,
+}
+
 /// The band table the GPU plans (glsl/render/splat/band_plan.comp): a 32-byte header (band
 /// count, status, total entries, live fragments, kernel evaluations as two words, two zeros),
 /// then 32 bytes per slot, the band's range and the indirect dispatch of the per-tile passes.

@@ -1,7 +1,7 @@
 //! The Rust mirrors of the splat shaders' uniform and push-constant blocks against the
 //! compiled shaders (SPIR-V reflection; the build keeps debug names): every member's name and
-//! offset, and the block's size. Pipelines check sizes when they are built; this also catches
-//! two members swapped or renamed on one side only.
+//! offset, and the block's size. Pipelines check push-constant sizes when they are built; this
+//! also catches two members swapped or renamed on one side only.
 
 use super::band_plan::BandPlanPush;
 use super::bands::BandPush;
@@ -55,13 +55,8 @@ fn band_push() -> BlockLayout {
     })
 }
 
-/// (shader, its frame block binding if it has one, its push-constant block if it has one)
-type ShaderBlocks = (
-    &'static str,
-    &'static [u8],
-    Option<u32>,
-    Option<BlockLayout>,
-);
+/// (shader, whether it reads the frame block, its push-constant block if it has one)
+type ShaderBlocks = (&'static str, &'static [u8], bool, Option<BlockLayout>);
 
 fn splat_shaders() -> Vec<ShaderBlocks> {
     use crate::shaders::*;
@@ -69,7 +64,7 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "input",
             RENDER_SPLAT_INPUT_COMP,
-            None,
+            false,
             Some(layout_of!(InputPush {
                 width,
                 height,
@@ -82,7 +77,7 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "fragments",
             RENDER_SPLAT_FRAGMENTS_COMP,
-            Some(8),
+            true,
             Some(layout_of!(FragmentsPush {
                 pupil_visibility,
                 focus_d,
@@ -92,23 +87,23 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "merge",
             RENDER_SPLAT_MERGE_COMP,
-            Some(5),
+            true,
             Some(layout_of!(MergePush {
                 block_size,
                 blur_per_block
             })),
         ),
-        ("tile count", RENDER_SPLAT_TILE_COUNT_COMP, Some(5), None),
+        ("tile count", RENDER_SPLAT_TILE_COUNT_COMP, true, None),
         (
             "prefix sum",
             RENDER_SPLAT_PREFIX_SUM_COMP,
-            None,
+            false,
             Some(layout_of!(PrefixSumPush { phase, count })),
         ),
         (
             "psf texture",
             RENDER_SPLAT_PSF_TEXTURE_COMP,
-            Some(6),
+            true,
             Some(layout_of!(PsfTexturePush {
                 first_level,
                 end_level,
@@ -124,25 +119,25 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
         (
             "tile fill",
             RENDER_SPLAT_TILE_FILL_COMP,
-            Some(8),
+            true,
             Some(band_push()),
         ),
         (
             "tile sort",
             RENDER_SPLAT_TILE_SORT_COMP,
-            None,
+            false,
             Some(band_push()),
         ),
         (
             "convolve",
             RENDER_SPLAT_CONVOLVE_COMP,
-            Some(12),
+            true,
             Some(band_push()),
         ),
         (
             "band plan",
             RENDER_SPLAT_BAND_PLAN_COMP,
-            None,
+            false,
             Some(layout_of!(BandPlanPush {
                 tiles_x,
                 tiles,
@@ -155,18 +150,16 @@ fn splat_shaders() -> Vec<ShaderBlocks> {
 
 #[test]
 fn shader_blocks_match_their_rust_structs_member_by_member() {
-    for (name, spirv, frame_binding, push) in splat_shaders() {
+    for (name, spirv, reads_frame, push) in splat_shaders() {
         let r = reflect(spirv).unwrap();
         let uniforms: Vec<_> = r.bindings.iter().filter(|b| b.block.is_some()).collect();
-        match frame_binding {
-            Some(binding) => {
-                assert_eq!(uniforms.len(), 1, "{name}: one uniform block");
-                assert_eq!(uniforms[0].binding, binding, "{name}: frame block binding");
-                // the frame block is each pass's last binding (the Rust side appends it)
-                assert_eq!(r.bindings.last().unwrap().binding, binding, "{name}");
-                assert_eq!(uniforms[0].block.as_ref(), Some(&frame_uniform()), "{name}");
-            }
-            None => assert!(uniforms.is_empty(), "{name}: no frame block"),
+        if reads_frame {
+            assert_eq!(uniforms.len(), 1, "{name}: one uniform block");
+            // passes bind it by this name
+            assert_eq!(uniforms[0].name, "FrameUniform", "{name}");
+            assert_eq!(uniforms[0].block.as_ref(), Some(&frame_uniform()), "{name}");
+        } else {
+            assert!(uniforms.is_empty(), "{name}: no frame block");
         }
         assert_eq!(r.push_constants, push, "{name}: push constants");
     }

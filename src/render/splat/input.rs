@@ -6,9 +6,7 @@
 //! layer, each draw followed by the input pass that stacks it under the earlier ones and
 //! hands its depth to the next peel on the GPU. Both feed the same passes after this.
 
-use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
-};
+use crate::gpu::{Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency};
 use crate::{Error, Result};
 
 use super::{FrameInput, FrameResources};
@@ -89,13 +87,6 @@ pub(super) struct InputPass {
 impl InputPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("input", crate::shaders::RENDER_SPLAT_INPUT_COMP)
-            .bindings(&[
-                BindingKind::StorageImage,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageImage,
-                BindingKind::StorageImage,
-                BindingKind::StorageImage,
-            ])
             .push_constants::<InputPush>()
             .build(ctx)?;
         Ok(InputPass { pipeline })
@@ -208,25 +199,21 @@ impl Source<'_, '_> {
                 for layer in 0..layers {
                     let out = recorded.record_layer(rec, layer)?;
                     rec.begin_pass("input");
-                    rec.dispatch(
-                        &pass.pipeline,
-                        &[
-                            Binding::Storage(out.color),
-                            Binding::Buffer(out.depth_m),
-                            Binding::Storage(&frame.color_in),
-                            Binding::Storage(&frame.depth_in),
-                            Binding::Storage(out.previous_depth),
-                        ],
-                        &InputPush {
+                    rec.compute(&pass.pipeline)
+                        .read("raster_color", out.color)
+                        .read("RasterDepth", out.depth_m)
+                        .write("color_in", &frame.color_in)
+                        .write("depth_in", &frame.depth_in)
+                        .write("previous_depth", out.previous_depth)
+                        .push(&InputPush {
                             width: frame.width,
                             height: frame.height,
                             layer,
                             write_previous: u32::from(layer + 1 < layers),
                             near_m: crate::render::focus::nearest_supported_m(),
                             far_m: out.far_m,
-                        },
-                        [frame.width.div_ceil(8), frame.height.div_ceil(8), 1],
-                    )?;
+                        })
+                        .dispatch([frame.width.div_ceil(8), frame.height.div_ceil(8), 1])?;
                 }
                 Ok(())
             }

@@ -35,7 +35,7 @@ mod uniform;
 use crate::gpu::{Buffer, Context, GpuError, Image, Residency, Sampler, Timings};
 use crate::psf::kernels::KernelGrid;
 
-use bands::{plan_bands, BandPush, PlannedBands};
+use bands::{plan_bands, BandPush, BandSlot, PlannedBands};
 pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{ConvolveWalk, MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
@@ -167,6 +167,20 @@ struct FrameResources {
     /// counts (tiles + 1, the last = live fragments), offsets (tiles + 1, the last = total),
     /// then the band table's header ([`band_header_at`]).
     readback_lists: Buffer,
+}
+
+/// What the passes of a frame bind: the frame's uniform block and per-size resources, and the
+/// splatter's tables and PSF texture. Each pass's `record` takes it whole and binds what its
+/// shader names.
+#[derive(Clone, Copy)]
+struct Resources<'a> {
+    block: FrameBlock<'a>,
+    frame: &'a FrameResources,
+    radii: &'a Buffer,
+    field_table: &'a Buffer,
+    texture: &'a Image,
+    sampler: &'a Sampler,
+    atlas: &'a Buffer,
 }
 
 pub struct Splatter {
@@ -351,6 +365,7 @@ impl Splatter {
             values: &params,
             buffer: &frame.uniform,
         };
+        let r = self.resources(frame, block);
         let tiles = frame.tiles_x * frame.tiles_y;
         let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
         let output_bytes = pixels as u64 * 16;
@@ -372,8 +387,8 @@ impl Splatter {
             let slots = steady_slots(self.last_lists.map_or(1, |(_, bands)| bands));
             let timings = ctx.submit(|rec| {
                 let texture = rebuild_texture.then_some(&blend);
-                self.record_front(rec, &source, frame, block, texture, hidden)?;
-                self.record_back(rec, frame, block, slots, entries)?;
+                self.record_front(rec, &source, &r, texture, hidden)?;
+                self.record_back(rec, &r, slots, entries)?;
                 sync = rec.barrier_counts();
                 Ok(())
             })?;
@@ -412,7 +427,7 @@ impl Splatter {
         // Planning frame: everything up to the exact list sizes, read back to size the list
         // buffer and count the bands; the GPU then plans the same bands (checked below).
         let mut timings = ctx.submit(|rec| {
-            self.record_front(rec, &source, frame, block, Some(&blend), hidden)?;
+            self.record_front(rec, &source, &r, Some(&blend), hidden)?;
             rec.end_pass();
             rec.copy_buffer_region(
                 &frame.counts,
@@ -459,13 +474,14 @@ impl Splatter {
             values: &params,
             buffer: &frame.uniform,
         };
+        let r = self.resources(frame, block);
         let entries = self.entries.as_ref().expect("ensured above");
         // The bands of the buffer actually made (it may hold more than the largest band, never
         // less): the plan every later steady frame repeats on the GPU.
         let bands = plan_bands(&counts, frame.tiles_x, u64::from(entries_in(entries)))?;
         let slots = bands.len() as u32;
         let band_timings = ctx.submit(|rec| {
-            self.record_back(rec, frame, block, slots, entries)?;
+            self.record_back(rec, &r, slots, entries)?;
             let (b, c) = rec.barrier_counts();
             sync = (sync.0 + b, sync.1 + c);
             Ok(())
@@ -544,17 +560,30 @@ impl Splatter {
         }
     }
 
+    /// What the passes of `frame` bind.
+    fn resources<'a>(&'a self, frame: &'a FrameResources, block: FrameBlock<'a>) -> Resources<'a> {
+        Resources {
+            block,
+            frame,
+            radii: &self.radii,
+            field_table: &self.field_table.buffer,
+            texture: &self.texture,
+            sampler: &self.sampler,
+            atlas: &self.atlas,
+        }
+    }
+
     /// Records the passes before the lists: inputs, PSF texture (given the blend when it
     /// changed), fragments, merging, tile counts and their prefix sum.
     fn record_front(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         source: &input::Source<'_, '_>,
-        frame: &FrameResources,
-        block: FrameBlock<'_>,
+        r: &Resources<'_>,
         rebuild_texture: Option<&crate::psf::kernels::GridBlend>,
         hidden: fragments::HiddenLight,
     ) -> crate::gpu::GpuResult<()> {
+        let frame = r.frame;
         source.record(rec, &self.input, frame)?;
         rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
         rec.copy_buffer(
@@ -572,58 +601,25 @@ impl Splatter {
                 rec.clear_image(&self.texture, [0.0; 4]);
             }
             let blocks: Vec<field::BlockKernels> = self.layout.blocks.iter().map(|b| b.0).collect();
-            for (node, resident) in self.resident.iter().enumerate() {
-                self.psf_texture.record(
-                    rec,
-                    block,
-                    resident,
-                    blend,
-                    node as u32,
-                    &self.texture,
-                    &self.atlas,
-                    &blocks,
-                )?;
-            }
+            self.psf_texture
+                .record(rec, r, &self.resident, blend, &blocks)?;
         }
         rec.begin_pass("fragments");
-        self.fragments_pass.record(
-            rec,
-            block,
-            &frame.color_in,
-            &frame.depth_in,
-            &self.radii,
-            &self.field_table.buffer,
-            &frame.fragments,
-            hidden,
-        )?;
-        if self.settings.merge.levels > 0 {
+        self.fragments_pass.record(rec, r, hidden)?;
+        let merge = &self.settings.merge;
+        if merge.levels > 0 {
             rec.begin_pass("merge");
-            self.merge.record(
-                rec,
-                block,
-                (
-                    self.settings.merge.levels,
-                    self.settings.merge.blur_per_block,
-                ),
-                &self.radii,
-                &frame.fragments,
-            )?;
+            self.merge
+                .record(rec, r, (merge.levels, merge.blur_per_block))?;
         }
         rec.begin_pass("tile count");
         // Alpha 0 marks a pixel the convolution has not written (it writes alpha 1 to every
         // pixel of its tiles): the host checks the frame it reads back.
         rec.clear_image(&frame.color_out, [0.0; 4]);
         rec.fill_buffer(&frame.counts, 0);
-        self.tile_count
-            .record(rec, block, &frame.fragments, &frame.counts)?;
+        self.tile_count.record(rec, r)?;
         rec.begin_pass("prefix sum");
-        self.prefix_sum.record(
-            rec,
-            frame.tiles_x * frame.tiles_y,
-            &frame.counts,
-            &frame.offsets,
-            &frame.block_sums,
-        )?;
+        self.prefix_sum.record(rec, r)?;
         Ok(())
     }
 
@@ -632,65 +628,29 @@ impl Splatter {
     fn record_back(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
-        frame: &FrameResources,
-        block: FrameBlock<'_>,
+        r: &Resources<'_>,
         slots: u32,
         entries: &Buffer,
     ) -> crate::gpu::GpuResult<()> {
+        let frame = r.frame;
         let entry_capacity = entries_in(entries);
         rec.begin_pass("band plan");
-        self.band_plan.record(
-            rec,
-            &band_plan::BandPlanPush {
-                tiles_x: frame.tiles_x,
-                tiles: frame.tiles_x * frame.tiles_y,
-                capacity: entry_capacity,
-                slots,
-            },
-            &frame.counts,
-            &frame.offsets,
-            &frame.band_table,
-        )?;
+        self.band_plan.record(rec, r, (slots, entry_capacity))?;
         for slot in 0..slots {
-            let band = BandPush {
-                slot,
-                entry_capacity,
+            let band = BandSlot {
+                push: BandPush {
+                    slot,
+                    entry_capacity,
+                },
+                entries,
             };
             rec.begin_pass("tile fill");
             rec.fill_buffer(&frame.cursors, 0);
-            self.tile_fill.record(
-                rec,
-                block,
-                &band,
-                &frame.band_table,
-                &frame.fragments,
-                &frame.offsets,
-                &frame.cursors,
-                entries,
-            )?;
+            self.tile_fill.record(rec, r, &band)?;
             rec.begin_pass("tile sort");
-            self.tile_sort.record(
-                rec,
-                &band,
-                &frame.band_table,
-                &frame.counts,
-                &frame.offsets,
-                entries,
-            )?;
+            self.tile_sort.record(rec, r, &band)?;
             rec.begin_pass("convolve");
-            self.convolve.record(
-                rec,
-                block,
-                &band,
-                &frame.band_table,
-                (&self.texture, &self.sampler, &self.atlas),
-                &self.field_table.buffer,
-                &frame.fragments,
-                &frame.counts,
-                &frame.offsets,
-                entries,
-                &frame.color_out,
-            )?;
+            self.convolve.record(rec, r, &band)?;
         }
         rec.copy_buffer_region(
             &frame.band_table,
