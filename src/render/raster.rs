@@ -13,9 +13,8 @@
 //! through the same `prepare` (uniforms through a persistent mapping) and `record`.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
-    GraphicsPipeline, Image, ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings,
-    VertexAttribute, VertexFormat,
+    Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer, GraphicsPipeline, Image,
+    ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings, VertexAttribute, VertexFormat,
 };
 use crate::image_io::{ImageGray, ImageRgba};
 use crate::scene::{FrameState, Light, Vertex, MAX_LIGHTS};
@@ -151,7 +150,6 @@ impl Rasterizer {
         let pipeline = Self::pipeline(ctx, false)?;
         let peel = Self::pipeline(ctx, true)?;
         let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
-            .bindings(&[BindingKind::SampledImage, BindingKind::StorageBuffer])
             .push_constants::<ResolvePush>()
             .build(ctx)?;
         let white = Image::new_2d(
@@ -183,22 +181,13 @@ impl Rasterizer {
     }
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
-    /// layer's depth).
+    /// layer's depth, `previous_depth` in glsl/render/raster_peel.frag).
     fn pipeline(ctx: &Context, peel: bool) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
         let (name, fragment) = if peel {
             ("raster peel", crate::shaders::RENDER_RASTER_PEEL_FRAG)
         } else {
             ("raster", crate::shaders::RENDER_RASTER_FRAG)
-        };
-        let bindings: &[BindingKind] = if peel {
-            &[
-                BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
-                BindingKind::SampledImage,
-            ]
-        } else {
-            &[BindingKind::UniformBuffer, BindingKind::SampledImage]
         };
         Ok(
             GraphicsPipeline::builder(name, crate::shaders::RENDER_RASTER_VERT, fragment)
@@ -222,7 +211,6 @@ impl Rasterizer {
                         },
                     ],
                 )
-                .bindings(bindings)
                 .push_constants::<MaterialPush>()
                 .samples(MSAA_SAMPLES)
                 .color_target(TexelFormat::Rgba32Float, true)
@@ -637,14 +625,19 @@ impl Rasterizer {
                     [lo as f32, hi as f32, 0.0, 0.0]
                 },
             };
-            let bindings = [
-                Binding::Buffer(&self.uniforms),
-                Binding::Sampled(texture, &self.texture_sampler),
-                Binding::Sampled(&targets.previous_depth, &self.point_sampler),
-            ];
+            let mut bound = pipeline
+                .bind()
+                .read("Frame", &self.uniforms)
+                .read("albedo_map", (texture, &self.texture_sampler));
+            if peel {
+                bound = bound.read(
+                    "previous_depth",
+                    (&targets.previous_depth, &self.point_sampler),
+                );
+            }
             rec.draw_indexed(
                 pipeline,
-                &bindings[..if peel { 3 } else { 2 }],
+                &bound.finish()?,
                 &push,
                 &gpu_scene.vertices,
                 &gpu_scene.indices,
@@ -654,19 +647,15 @@ impl Rasterizer {
         }
         rec.end_render_pass()?;
         rec.begin_pass("depth resolve");
-        rec.dispatch(
-            &self.resolve,
-            &[
-                Binding::Sampled(&targets.view_depth_ms, &self.point_sampler),
-                Binding::Buffer(&targets.depth),
-            ],
-            &ResolvePush {
+        rec.compute(&self.resolve)
+            .read("view_depth", (&targets.view_depth_ms, &self.point_sampler))
+            .write("Depth", &targets.depth)
+            .push(&ResolvePush {
                 width,
                 height,
                 samples: MSAA_SAMPLES,
-            },
-            [width.div_ceil(8), height.div_ceil(8), 1],
-        )?;
+            })
+            .dispatch([width.div_ceil(8), height.div_ceil(8), 1])?;
         // The MSAA targets live as long as the framebuffers that use them.
         let _ = (&targets.color_ms, &targets.depth_ms);
         Ok(())
