@@ -98,7 +98,7 @@ pub struct GraphicsPipelineBuilder<'a> {
     attributes: Vec<VertexAttribute>,
     /// Binding kinds the pass declares, if it does (checked against the shaders).
     kinds: Option<Vec<BindingKind>>,
-    push_constant_bytes: u32,
+    push: super::pipeline::PushDecl,
     colors: Vec<ColorTarget>,
     depth: Option<(TexelFormat, DepthCompare)>,
     samples: u32,
@@ -136,7 +136,7 @@ impl GraphicsPipeline {
             vertex_stride: 0,
             attributes: Vec::new(),
             kinds: None,
-            push_constant_bytes: 0,
+            push: super::pipeline::PushDecl::of::<()>(),
             colors: Vec::new(),
             depth: None,
             samples: 1,
@@ -304,9 +304,10 @@ impl<'a> GraphicsPipelineBuilder<'a> {
         self
     }
 
-    /// The push-constant block (both stages) as the bytes of `T`.
-    pub fn push_constants<T: bytemuck::Pod>(mut self) -> Self {
-        self.push_constant_bytes = std::mem::size_of::<T>() as u32;
+    /// The push-constant block (both stages) as the bytes of `T` (see
+    /// `ComputePipelineBuilder::push_constants`).
+    pub fn push_constants<T: super::ShaderBlock>(mut self) -> Self {
+        self.push = super::pipeline::PushDecl::of::<T>();
         self
     }
 
@@ -367,7 +368,7 @@ impl<'a> GraphicsPipelineBuilder<'a> {
             self.name,
             self.kinds.as_deref(),
             &[],
-            self.push_constant_bytes,
+            self.push,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
             &[self.vertex_spirv, self.fragment_spirv],
         )?;

@@ -4,6 +4,7 @@
 
 mod access;
 mod bind;
+mod block;
 mod buffer;
 mod commands;
 mod context;
@@ -17,6 +18,8 @@ mod submit_slot;
 pub mod texture_probe;
 
 pub use bind::{Bindable, Dispatch, NamedBindings};
+pub(crate) use block::shader_block;
+pub use block::ShaderBlock;
 pub use buffer::{Buffer, Residency};
 pub use commands::{PassTime, Recorder, Timings};
 pub use context::{

@@ -6,11 +6,12 @@ use std::sync::Arc;
 
 use ash::vk;
 
+use super::block::{check_block, ShaderBlock};
 use super::buffer::Buffer;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::{Image, Sampler};
-use super::reflect::{reflect, Access};
+use super::reflect::{reflect, Access, BlockLayout};
 
 /// The kind of resource a shader binding expects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,6 +67,23 @@ pub(crate) struct PipelineParts<'p> {
     pub(crate) bind_point: vk::PipelineBindPoint,
 }
 
+/// The push-constant struct a pass declares: its size, and the check of its members against
+/// the shader's block (`check_block`).
+#[derive(Clone, Copy)]
+pub(crate) struct PushDecl {
+    pub(crate) bytes: u32,
+    check: fn(&str, Option<&BlockLayout>) -> Result<(), String>,
+}
+
+impl PushDecl {
+    pub(crate) fn of<T: ShaderBlock>() -> PushDecl {
+        PushDecl {
+            bytes: std::mem::size_of::<T>() as u32,
+            check: check_block::<T>,
+        }
+    }
+}
+
 /// One binding of a pass's descriptor set, as its shaders declare it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct Slot {
@@ -100,10 +118,11 @@ impl Layout {
         name: &str,
         declared: Option<&[BindingKind]>,
         uniform_bytes: &[(u32, u32)],
-        push_constant_bytes: u32,
+        push: PushDecl,
         stages: vk::ShaderStageFlags,
         modules: &[&[u8]],
     ) -> GpuResult<Layout> {
+        let push_constant_bytes = push.bytes;
         let usage = |message: String| GpuError::Usage {
             pass: name.to_string(),
             message,
@@ -114,8 +133,7 @@ impl Layout {
                 "{push_constant_bytes} bytes of push constants in pass \"{name}\" (limit {max_push})"
             )));
         }
-        let slots = slots_of_shaders(declared, uniform_bytes, push_constant_bytes, modules)
-            .map_err(usage)?;
+        let slots = slots_of_shaders(declared, uniform_bytes, push, modules).map_err(usage)?;
         let mut out = Layout {
             shared: shared.clone(),
             slots,
@@ -191,18 +209,18 @@ impl Layout {
 
 /// The bindings 0, 1, … of set 0 over every module in `modules` (access joined over the
 /// stages), checked against the declared kinds (when the pass declares them) and uniform-block
-/// sizes (binding, bytes), and the push-constant size against the pass's.
+/// sizes (binding, bytes), and the push-constant block against the pass's struct.
 fn slots_of_shaders(
     declared: Option<&[BindingKind]>,
     uniform_bytes: &[(u32, u32)],
-    push_constant_bytes: u32,
+    push: PushDecl,
     modules: &[&[u8]],
 ) -> Result<Vec<Slot>, String> {
     let mut found: std::collections::BTreeMap<u32, Slot> = Default::default();
-    let mut push = 0;
+    let mut push_block = None;
     for spirv in modules {
         let r = reflect(spirv)?;
-        push = push.max(r.push_constant_bytes);
+        push_block = push_block.or(r.push_constants);
         for b in r.bindings {
             if let Some(kinds) = declared {
                 let Some(kind) = kinds.get(b.binding as usize) else {
@@ -251,11 +269,7 @@ fn slots_of_shaders(
             }
         }
     }
-    if push != push_constant_bytes {
-        return Err(format!(
-            "the shader's push-constant block is {push} bytes, the pass's struct {push_constant_bytes}"
-        ));
-    }
+    (push.check)("push-constant", push_block.as_ref())?;
     let count = declared.map_or(found.len(), <[BindingKind]>::len);
     let slots: Vec<Slot> = (0..count as u32)
         .map(|i| {
@@ -292,7 +306,7 @@ pub struct ComputePipelineBuilder<'a> {
     kinds: Option<Vec<BindingKind>>,
     /// (binding, bytes) of the uniform blocks declared with a struct.
     uniform_bytes: Vec<(u32, u32)>,
-    push_constant_bytes: u32,
+    push: PushDecl,
     specialization: Vec<(u32, u32)>,
 }
 
@@ -304,7 +318,7 @@ impl ComputePipeline {
             spirv,
             kinds: None,
             uniform_bytes: Vec::new(),
-            push_constant_bytes: 0,
+            push: PushDecl::of::<()>(),
             specialization: Vec::new(),
         }
     }
@@ -350,10 +364,11 @@ impl<'a> ComputePipelineBuilder<'a> {
         self
     }
 
-    /// Declares the push-constant block as the bytes of `T` (a `#[repr(C)]` Pod struct that
-    /// mirrors the GLSL block with std430 layout).
-    pub fn push_constants<T: bytemuck::Pod>(mut self) -> Self {
-        self.push_constant_bytes = std::mem::size_of::<T>() as u32;
+    /// Declares the push-constant block as the bytes of `T`: a struct that mirrors the GLSL
+    /// block with std430 layout, made with `shader_block!` so that its members are checked
+    /// against the shader's when the pipeline is built (a plain `u32` or array: its size).
+    pub fn push_constants<T: ShaderBlock>(mut self) -> Self {
+        self.push = PushDecl::of::<T>();
         self
     }
 
@@ -377,7 +392,7 @@ impl<'a> ComputePipelineBuilder<'a> {
             self.name,
             self.kinds.as_deref(),
             &self.uniform_bytes,
-            self.push_constant_bytes,
+            self.push,
             vk::ShaderStageFlags::COMPUTE,
             &[self.spirv],
         )?;

@@ -1,12 +1,13 @@
 //! Samples a 3D image through a sampler at arbitrary points on the GPU and reads the values
 //! back: what a shader sees, for comparison with CPU references.
 
-use super::{Buffer, ComputePipeline, Context, GpuResult, Image, Residency, Sampler};
+use super::{shader_block, Buffer, ComputePipeline, Context, GpuResult, Image, Residency, Sampler};
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Push {
-    count: u32,
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct Push {
+        count: u32,
+    }
 }
 
 pub struct TextureProbe {

@@ -13,8 +13,9 @@
 //! through the same `prepare` (uniforms through a persistent mapping) and `record`.
 
 use crate::gpu::{
-    Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer, GraphicsPipeline, Image,
-    ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings, VertexAttribute, VertexFormat,
+    shader_block, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
+    GraphicsPipeline, Image, ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings,
+    VertexAttribute, VertexFormat,
 };
 use crate::image_io::{ImageGray, ImageRgba};
 use crate::scene::{FrameState, Light, Vertex, MAX_LIGHTS};
@@ -84,22 +85,24 @@ struct FrameUniform {
     lights: [LightGpu; MAX_LIGHTS],
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct MaterialPush {
-    albedo: [f32; 4],
-    emission: [f32; 4],
-    /// x, y: the nearest and farthest view depth (m) of the batch's box within the clip range
-    /// (see raster_shade.glsl).
-    depth_range_m: [f32; 4],
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct MaterialPush {
+        albedo: [f32; 4],
+        emission: [f32; 4],
+        /// x, y: the nearest and farthest view depth (m) of the batch's box within the clip range
+        /// (see raster_shade.glsl).
+        depth_range_m: [f32; 4],
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ResolvePush {
-    width: u32,
-    height: u32,
-    samples: u32,
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct ResolvePush {
+        width: u32,
+        height: u32,
+        samples: u32,
+    }
 }
 
 /// Scene data uploaded once and reused while the same scene is rendered.

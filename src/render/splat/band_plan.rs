@@ -2,21 +2,22 @@
 //! the prefix sum, and writes the band table the list passes read (their ranges and the
 //! indirect dispatches of tile sort and convolve). See glsl/render/splat/band_plan.comp.
 
-use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
 
 use super::Resources;
 
-/// Push constants of the band-plan dispatch. Mirrors `BandPlanPush` in
-/// glsl/render/splat/band_plan.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct BandPlanPush {
-    pub tiles_x: u32,
-    pub tiles: u32,
-    /// Entries the list buffer holds.
-    pub capacity: u32,
-    /// Slots recorded after this dispatch.
-    pub slots: u32,
+shader_block! {
+    /// Push constants of the band-plan dispatch. Mirrors `BandPlanPush` in
+    /// glsl/render/splat/band_plan.comp.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct BandPlanPush {
+        pub tiles_x: u32,
+        pub tiles: u32,
+        /// Entries the list buffer holds.
+        pub capacity: u32,
+        /// Slots recorded after this dispatch.
+        pub slots: u32,
+    }
 }
 
 pub(super) struct BandPlanPass {

@@ -2,7 +2,8 @@
 //! See glsl/render/splat/fragments.comp.
 
 use crate::gpu::{
-    Bindable, Binding, Buffer, ComputePipeline, Context, GpuResult, Recorder, Residency,
+    shader_block, Bindable, Binding, Buffer, ComputePipeline, Context, GpuResult, Recorder,
+    Residency,
 };
 
 use super::{Resources, FRAGMENT_BYTES};
@@ -88,14 +89,15 @@ pub(super) struct HiddenLight {
     pub parallax_px_per_d: f32,
 }
 
-/// Push constants of the fragments pass. Mirrors `FragmentsPush` in
-/// glsl/render/splat/fragments.comp; see [`HiddenLight`].
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct FragmentsPush {
-    pub pupil_visibility: u32,
-    pub focus_d: f32,
-    pub parallax_px_per_d: f32,
+shader_block! {
+    /// Push constants of the fragments pass. Mirrors `FragmentsPush` in
+    /// glsl/render/splat/fragments.comp; see [`HiddenLight`].
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct FragmentsPush {
+        pub pupil_visibility: u32,
+        pub focus_d: f32,
+        pub parallax_px_per_d: f32,
+    }
 }
 
 pub(super) struct FragmentsPass {

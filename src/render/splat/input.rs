@@ -6,7 +6,9 @@
 //! layer, each draw followed by the input pass that stacks it under the earlier ones and
 //! hands its depth to the next peel on the GPU. Both feed the same passes after this.
 
-use crate::gpu::{Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency};
+use crate::gpu::{
+    shader_block, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
+};
 use crate::{Error, Result};
 
 use super::{FrameInput, FrameResources};
@@ -67,17 +69,18 @@ pub(super) struct Staging {
     depth: Buffer,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct InputPush {
-    pub width: u32,
-    pub height: u32,
-    /// Which layer of the stack this dispatch writes (its rows start at layer · height).
-    pub layer: u32,
-    /// 1 where another layer follows and reads this one's depth.
-    pub write_previous: u32,
-    pub near_m: f32,
-    pub far_m: f32,
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct InputPush {
+        pub width: u32,
+        pub height: u32,
+        /// Which layer of the stack this dispatch writes (its rows start at layer · height).
+        pub layer: u32,
+        /// 1 where another layer follows and reads this one's depth.
+        pub write_previous: u32,
+        pub near_m: f32,
+        pub far_m: f32,
+    }
 }
 
 pub(super) struct InputPass {

@@ -2,19 +2,20 @@
 //! optionally 4×4 up to 32×32): the seed paper's similar-colour rule, or level of detail by
 //! blur. See glsl/render/splat/merge.comp.
 
-use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
 
 use super::Resources;
 
-/// Push constants of one merge dispatch. Mirrors `MergePush` in glsl/render/splat/merge.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct MergePush {
-    /// Side of the blocks this dispatch makes: 2, then 4, … 32.
-    pub block_size: u32,
-    /// Level of detail by blur (see [`super::MergeSettings::blur_per_block`]); 0: the seed
-    /// paper's tolerances.
-    pub blur_per_block: f32,
+shader_block! {
+    /// Push constants of one merge dispatch. Mirrors `MergePush` in glsl/render/splat/merge.comp.
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct MergePush {
+        /// Side of the blocks this dispatch makes: 2, then 4, … 32.
+        pub block_size: u32,
+        /// Level of detail by blur (see [`super::MergeSettings::blur_per_block`]); 0: the seed
+        /// paper's tolerances.
+        pub blur_per_block: f32,
+    }
 }
 
 pub(super) struct MergePass {

@@ -1,19 +1,20 @@
 //! Prefix-sum pass: exclusive scan of the tile counts into list offsets, plus the total.
 //! See glsl/render/splat/prefix_sum.comp.
 
-use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
 
 use super::Resources;
 
-/// Push constants of one prefix-sum dispatch. Mirrors `PrefixSumPush` in
-/// glsl/render/splat/prefix_sum.comp (the scan needs no frame values).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct PrefixSumPush {
-    /// 0: scan blocks of 1024; 1: scan the block totals; 2: add each block's base.
-    pub phase: u32,
-    /// Values scanned.
-    pub count: u32,
+shader_block! {
+    /// Push constants of one prefix-sum dispatch. Mirrors `PrefixSumPush` in
+    /// glsl/render/splat/prefix_sum.comp (the scan needs no frame values).
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct PrefixSumPush {
+        /// 0: scan blocks of 1024; 1: scan the block totals; 2: add each block's base.
+        pub phase: u32,
+        /// Values scanned.
+        pub count: u32,
+    }
 }
 
 pub(super) struct PrefixSumPass {

@@ -2,7 +2,8 @@
 //! into the 3D texture the convolution samples. See glsl/render/splat/psf_texture.comp.
 
 use crate::gpu::{
-    Binding, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage, Recorder, TexelFormat,
+    shader_block, Binding, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage,
+    Recorder, TexelFormat,
 };
 use crate::psf::kernels::{
     level_block_radius, level_count, texels_below_level, GridBlend, KernelGrid, KernelSet,
@@ -11,29 +12,30 @@ use crate::psf::kernels::{
 use super::field::BlockKernels;
 use super::Resources;
 
-/// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node, its
-/// plain kernels or one block side's). Mirrors `PsfTexturePush` in
-/// glsl/render/splat/psf_texture.comp (std430: the vec4 sits at offset 16, right after the
-/// four uints).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct PsfTexturePush {
-    /// The chunk's radius levels [first_level, end_level).
-    pub first_level: u32,
-    pub end_level: u32,
-    /// Index of the chunk's first texel in a whole kernel set.
-    pub first_texel: u32,
-    /// The field node (h-major; on axis 0) whose region of the atlas is written
-    /// (`field::TextureLayout`).
-    pub node: u32,
-    /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
-    pub corner_weights: [f32; 4],
-    /// 0: the plain kernels; 4, 8, 16 or 32: the kernels summed over blocks of that side.
-    pub block_side: u32,
-    /// To the block's 48 bytes (std430 rounds it to the vec4's alignment).
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
+shader_block! {
+    /// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node, its
+    /// plain kernels or one block side's). Mirrors `PsfTexturePush` in
+    /// glsl/render/splat/psf_texture.comp (std430: the vec4 sits at offset 16, right after the
+    /// four uints).
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct PsfTexturePush {
+        /// The chunk's radius levels [first_level, end_level).
+        pub first_level: u32,
+        pub end_level: u32,
+        /// Index of the chunk's first texel in a whole kernel set.
+        pub first_texel: u32,
+        /// The field node (h-major; on axis 0) whose region of the atlas is written
+        /// (`field::TextureLayout`).
+        pub node: u32,
+        /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
+        pub corner_weights: [f32; 4],
+        /// 0: the plain kernels; 4, 8, 16 or 32: the kernels summed over blocks of that side.
+        pub block_side: u32,
+        /// To the block's 48 bytes (std430 rounds it to the vec4's alignment).
+        pub pad0: u32,
+        pub pad1: u32,
+        pub pad2: u32,
+    }
 }
 
 /// Texel format of the PSF texture: half floats halve memory and bandwidth; kernels are
