@@ -19,7 +19,7 @@ struct Fragment {
 // Per-frame constants, identical for every pass and every dispatch of a frame: a uniform
 // buffer the host writes once per frame through its mapping (values that change between the
 // dispatches of a frame are each pass's own push constants). Each shader defines FRAME_BINDING,
-// its last binding, before including this file. std140: scalars only, so the layout is that of
+// a binding number of its own, before including this file; passes bind the block by its name. std140: scalars only, so the layout is that of
 // `FrameUniform` in src/render/splat/mod.rs (a vec3 or an array here would need padding there).
 #ifndef FRAME_BINDING
 #error "define FRAME_BINDING (the binding of the frame's uniform block) before splat.glsl"

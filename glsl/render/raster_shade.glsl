@@ -9,7 +9,7 @@ layout(push_constant) uniform Material {
     vec4 emission;
     // x, y: nearest and farthest view depth (m) of this draw's bounding box, within the clip
     // range.
-    vec4 depth_range;
+    vec4 depth_range_m;
 } material;
 
 layout(location = 0) in vec3 world_position;
@@ -30,7 +30,7 @@ const float PI = 3.14159265358979;
 // lies inside the box around its vertices; the clamp is inactive on every well-conditioned
 // fragment.
 float fragment_view_depth() {
-    return clamp(view_depth, material.depth_range.x, material.depth_range.y);
+    return clamp(view_depth, material.depth_range_m.x, material.depth_range_m.y);
 }
 
 void shade_fragment() {

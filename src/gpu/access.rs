@@ -9,8 +9,7 @@ use ash::vk;
 
 use super::buffer::Buffer;
 use super::image::Image;
-use super::pipeline::Binding;
-use super::reflect::Access;
+use super::pipeline::{Binding, Slot};
 
 /// A region of device memory one command touches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,15 +100,15 @@ impl Hazards {
 /// The reads and writes of a dispatch or draw: each binding with its reflected access.
 pub(crate) fn binding_access(
     bindings: &[Binding<'_>],
-    access: &[Access],
+    slots: &[Slot],
 ) -> (Vec<Resource>, Vec<Resource>) {
     let (mut reads, mut writes) = (Vec::new(), Vec::new());
-    for (b, a) in bindings.iter().zip(access) {
+    for (b, slot) in bindings.iter().zip(slots) {
         let r = Resource::of_binding(b);
-        if a.reads() {
+        if slot.access.reads() {
             reads.push(r);
         }
-        if a.writes() {
+        if slot.access.writes() {
             writes.push(r);
         }
     }

@@ -171,6 +171,61 @@ impl Buffer {
             .map(|s| &s[..size])
     }
 
+    /// Writes `data` through the mapping of this host-visible buffer (`Upload`), starting at
+    /// element `first` (elements of `T`). Nothing is submitted: a command recorded after this
+    /// reads it.
+    pub fn write_mapped<T: bytemuck::Pod>(&mut self, first: usize, data: &[T]) -> GpuResult<()> {
+        let bytes: &[u8] = bytemuck::cast_slice(data);
+        let start = first * std::mem::size_of::<T>();
+        if let Some(error) = self.mapped_range_error(start, bytes.len()) {
+            return Err(error);
+        }
+        match self.mapped_bytes_mut() {
+            Some(mapped) => {
+                mapped[start..start + bytes.len()].copy_from_slice(bytes);
+                Ok(())
+            }
+            None => Err(self.not_mapped()),
+        }
+    }
+
+    /// Reads `count` `T`s from element `first` through the mapping of this host-visible buffer
+    /// (`Readback`, or `Upload`), once the submission that wrote them has completed.
+    pub fn read_mapped<T: bytemuck::Pod>(&self, first: usize, count: usize) -> GpuResult<Vec<T>> {
+        let size = std::mem::size_of::<T>();
+        if let Some(error) = self.mapped_range_error(first * size, count * size) {
+            return Err(error);
+        }
+        let bytes = self.mapped_bytes().ok_or_else(|| self.not_mapped())?;
+        // The mapped pointer need not be aligned for T: copy element-wise.
+        Ok(bytemuck::pod_collect_to_vec(
+            &bytes[first * size..(first + count) * size],
+        ))
+    }
+
+    /// Every whole `T` this host-visible buffer holds, read through its mapping.
+    pub fn read_mapped_all<T: bytemuck::Pod>(&self) -> GpuResult<Vec<T>> {
+        self.read_mapped(0, self.size_bytes as usize / std::mem::size_of::<T>())
+    }
+
+    fn mapped_range_error(&self, start: usize, len: usize) -> Option<GpuError> {
+        (start as u64 + len as u64 > self.size_bytes).then(|| GpuError::Usage {
+            pass: self.name.clone(),
+            message: format!(
+                "mapped access to bytes {start}..{} of a buffer of {}",
+                start + len,
+                self.size_bytes
+            ),
+        })
+    }
+
+    fn not_mapped(&self) -> GpuError {
+        GpuError::Usage {
+            pass: self.name.clone(),
+            message: "mapped access to a buffer that is not host-visible".into(),
+        }
+    }
+
     /// Copies `data` to the start of this buffer (via a staging buffer when device-local).
     pub fn upload<T: bytemuck::Pod>(&self, ctx: &Context, data: &[T]) -> GpuResult<()> {
         let bytes: &[u8] = bytemuck::cast_slice(data);
@@ -193,10 +248,7 @@ impl Buffer {
             bytes.len() as u64,
             Residency::Upload,
         )?;
-        staging
-            .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")[..bytes.len()]
-            .copy_from_slice(bytes);
+        staging.write_mapped(0, bytes)?;
         ctx.submit(|rec| {
             rec.copy_buffer(&staging, self, bytes.len() as u64);
             Ok(())
@@ -216,14 +268,7 @@ impl Buffer {
             rec.copy_buffer(self, &readback, self.size_bytes);
             Ok(())
         })?;
-        let bytes = readback
-            .mapped_bytes()
-            .expect("read-back buffers are host-visible");
-        let count = bytes.len() / std::mem::size_of::<T>();
-        // The mapped pointer need not be aligned for T: copy element-wise.
-        Ok(bytemuck::pod_collect_to_vec(
-            &bytes[..count * std::mem::size_of::<T>()],
-        ))
+        readback.read_mapped_all()
     }
 }
 
@@ -241,5 +286,29 @@ impl Drop for Buffer {
         // SAFETY: submissions wait for completion before returning, so the GPU no longer uses
         // this buffer.
         unsafe { self.shared.device.destroy_buffer(self.raw, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Typed mapped writes land at their element offset and read back as written; an access
+    /// past the end is an error, not a panic. (Not tested: a device buffer that is not
+    /// host-visible; lavapipe maps all its memory.)
+    #[test]
+    fn mapped_reads_and_writes_are_typed_and_checked() {
+        let ctx = crate::gpu::testing::gpu();
+        let mut upload = Buffer::new(&ctx, "typed", 64, Residency::Upload).unwrap();
+        upload.write_mapped(0, &[[1.0f32, 2.0]]).unwrap();
+        upload.write_mapped(3, &[7u32, 8]).unwrap();
+        assert_eq!(upload.read_mapped::<u32>(3, 2).unwrap(), [7, 8]);
+        assert_eq!(upload.read_mapped::<f32>(0, 2).unwrap(), [1.0, 2.0]);
+        assert_eq!(upload.read_mapped_all::<[u32; 4]>().unwrap().len(), 4);
+        let past = upload.write_mapped(15, &[1u32, 2]).unwrap_err().to_string();
+        assert!(past.contains("bytes 60..68 of a buffer of 64"), "{past}");
+        assert!(upload.read_mapped::<u64>(8, 1).is_err());
+        drop(upload);
+        crate::gpu::testing::finish(ctx);
     }
 }

@@ -388,10 +388,7 @@ impl<'a> Recorder<'a> {
             bytes.len() as u64,
             super::Residency::Upload,
         )?;
-        staging
-            .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")[..bytes.len()]
-            .copy_from_slice(bytes);
+        staging.write_mapped(0, bytes)?;
         self.copy_buffer(&staging, dst, bytes.len() as u64);
         self.keep_alive.push(staging);
         Ok(())
@@ -475,13 +472,29 @@ impl<'a> Recorder<'a> {
         Ok(set)
     }
 
-    /// Binds `bindings` (in the pipeline's declared order) and `push_constants`, and
+    /// Binds `bindings` (in the pipeline's binding order) and `push_constants`, and
     /// dispatches `groups` workgroups, after a barrier if it depends on earlier commands.
+    /// Passes bind by name instead ([`Recorder::compute`]).
     pub fn dispatch<P: bytemuck::Pod>(
         &mut self,
         pipeline: &ComputePipeline,
         bindings: &[Binding<'_>],
         push_constants: &P,
+        groups: [u32; 3],
+    ) -> GpuResult<()> {
+        self.dispatch_bytes(
+            pipeline,
+            bindings,
+            bytemuck::bytes_of(push_constants),
+            groups,
+        )
+    }
+
+    pub(super) fn dispatch_bytes(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[Binding<'_>],
+        push: &[u8],
         groups: [u32; 3],
     ) -> GpuResult<()> {
         if let Some(open) = &self.render_pass_open {
@@ -490,11 +503,7 @@ impl<'a> Recorder<'a> {
                 message: format!("dispatch inside the render pass of \"{open}\""),
             });
         }
-        self.bind(
-            &pipeline.parts(),
-            bindings,
-            bytemuck::bytes_of(push_constants),
-        )?;
+        self.bind(&pipeline.parts(), bindings, push)?;
         let max = self.ctx.limits().max_compute_work_group_count;
         if groups.iter().zip(max.iter()).any(|(g, m)| g > m) {
             return Err(GpuError::Usage {
@@ -507,7 +516,7 @@ impl<'a> Recorder<'a> {
         if groups.contains(&0) {
             return Ok(());
         }
-        let (reads, writes) = binding_access(bindings, &pipeline.layout.access);
+        let (reads, writes) = binding_access(bindings, &pipeline.layout.slots);
         self.sync(&reads, &writes);
         // SAFETY: recording; pipeline, set and push constants were bound by bind().
         unsafe {
@@ -526,18 +535,31 @@ impl<'a> Recorder<'a> {
         args: &Buffer,
         offset: u64,
     ) -> GpuResult<()> {
+        self.dispatch_indirect_bytes(
+            pipeline,
+            bindings,
+            bytemuck::bytes_of(push_constants),
+            args,
+            offset,
+        )
+    }
+
+    pub(super) fn dispatch_indirect_bytes(
+        &mut self,
+        pipeline: &ComputePipeline,
+        bindings: &[Binding<'_>],
+        push: &[u8],
+        args: &Buffer,
+        offset: u64,
+    ) -> GpuResult<()> {
         if let Some(open) = &self.render_pass_open {
             return Err(GpuError::Usage {
                 pass: pipeline.name.clone(),
                 message: format!("dispatch inside the render pass of \"{open}\""),
             });
         }
-        self.bind(
-            &pipeline.parts(),
-            bindings,
-            bytemuck::bytes_of(push_constants),
-        )?;
-        let (mut reads, writes) = binding_access(bindings, &pipeline.layout.access);
+        self.bind(&pipeline.parts(), bindings, push)?;
+        let (mut reads, writes) = binding_access(bindings, &pipeline.layout.slots);
         reads.push(Resource::buffer_range(args, offset, 12));
         self.sync(&reads, &writes);
         // SAFETY: recording; the args buffer has INDIRECT usage and holds 12 bytes at offset.
@@ -558,11 +580,12 @@ impl<'a> Recorder<'a> {
             pass: pipeline.name.to_string(),
             message,
         };
-        if bindings.len() != pipeline.layout.kinds.len() {
+        let slots = &pipeline.layout.slots;
+        if bindings.len() != slots.len() {
             return Err(usage(format!(
                 "{} bindings given, the pipeline declares {}",
                 bindings.len(),
-                pipeline.layout.kinds.len()
+                slots.len()
             )));
         }
         if push.len() as u32 != pipeline.layout.push_constant_bytes {
@@ -572,13 +595,13 @@ impl<'a> Recorder<'a> {
                 pipeline.layout.push_constant_bytes
             )));
         }
-        for (i, (binding, kind)) in bindings.iter().zip(&pipeline.layout.kinds).enumerate() {
-            if !binding.matches(*kind) {
-                return Err(usage(format!("binding {i} must be a {kind:?}")));
+        for (i, (binding, slot)) in bindings.iter().zip(slots).enumerate() {
+            if !binding.matches(slot.kind) {
+                return Err(usage(format!("binding {i} must be a {:?}", slot.kind)));
             }
         }
         let max_range = u64::from(self.ctx.limits().max_storage_buffer_range);
-        let set = if pipeline.layout.kinds.is_empty() {
+        let set = if slots.is_empty() {
             None
         } else {
             Some(self.allocate_set(pipeline.layout.set_layout)?)
@@ -588,9 +611,7 @@ impl<'a> Recorder<'a> {
         for (i, binding) in bindings.iter().enumerate() {
             match *binding {
                 Binding::Buffer(b) => {
-                    if pipeline.layout.kinds[i] == BindingKind::StorageBuffer
-                        && b.size_bytes() > max_range
-                    {
+                    if slots[i].kind == BindingKind::StorageBuffer && b.size_bytes() > max_range {
                         return Err(usage(format!(
                             "buffer \"{}\" of {} MiB exceeds this device's {} MiB storage-buffer binding limit; bind it in ranges",
                             b.name(),
@@ -644,7 +665,7 @@ impl<'a> Recorder<'a> {
                 vk::WriteDescriptorSet::default()
                     .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
-                    .descriptor_type(pipeline.layout.kinds[*i].descriptor_type())
+                    .descriptor_type(slots[*i].kind.descriptor_type())
                     .buffer_info(std::slice::from_ref(info)),
             );
         }
@@ -653,7 +674,7 @@ impl<'a> Recorder<'a> {
                 vk::WriteDescriptorSet::default()
                     .dst_set(set.unwrap_or_default())
                     .dst_binding(*i as u32)
-                    .descriptor_type(pipeline.layout.kinds[*i].descriptor_type())
+                    .descriptor_type(slots[*i].kind.descriptor_type())
                     .image_info(std::slice::from_ref(info)),
             );
         }

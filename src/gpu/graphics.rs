@@ -96,8 +96,9 @@ pub struct GraphicsPipelineBuilder<'a> {
     fragment_spirv: &'a [u8],
     vertex_stride: u32,
     attributes: Vec<VertexAttribute>,
-    kinds: Vec<BindingKind>,
-    push_constant_bytes: u32,
+    /// Binding kinds the pass declares, if it does (checked against the shaders).
+    kinds: Option<Vec<BindingKind>>,
+    push: super::pipeline::PushDecl,
     colors: Vec<ColorTarget>,
     depth: Option<(TexelFormat, DepthCompare)>,
     samples: u32,
@@ -134,8 +135,8 @@ impl GraphicsPipeline {
             fragment_spirv,
             vertex_stride: 0,
             attributes: Vec::new(),
-            kinds: Vec::new(),
-            push_constant_bytes: 0,
+            kinds: None,
+            push: super::pipeline::PushDecl::of::<()>(),
             colors: Vec::new(),
             depth: None,
             samples: 1,
@@ -149,6 +150,12 @@ impl GraphicsPipeline {
 
     pub fn samples(&self) -> u32 {
         self.samples
+    }
+
+    /// Starts binding a draw's resources by their names in the shaders; `finish` gives the
+    /// list `draw` and `draw_indexed` take.
+    pub fn bind(&self) -> super::bind::NamedBindings<'_> {
+        super::bind::NamedBindings::new(&self.name, &self.layout)
     }
 
     pub(crate) fn parts(&self) -> PipelineParts<'_> {
@@ -289,15 +296,18 @@ impl<'a> GraphicsPipelineBuilder<'a> {
         self
     }
 
-    /// Declares bindings 0, 1, 2, … of set 0, visible to both shader stages.
+    /// Optional: declares bindings 0, 1, 2, … of set 0, to be checked against the shaders
+    /// when the pipeline is built. Without it the layout is the shaders' (both stages see
+    /// every binding; draws bind by name).
     pub fn bindings(mut self, kinds: &[BindingKind]) -> Self {
-        self.kinds = kinds.to_vec();
+        self.kinds = Some(kinds.to_vec());
         self
     }
 
-    /// The push-constant block (both stages) as the bytes of `T`.
-    pub fn push_constants<T: bytemuck::Pod>(mut self) -> Self {
-        self.push_constant_bytes = std::mem::size_of::<T>() as u32;
+    /// The push-constant block (both stages) as the bytes of `T` (see
+    /// `ComputePipelineBuilder::push_constants`).
+    pub fn push_constants<T: super::ShaderBlock>(mut self) -> Self {
+        self.push = super::pipeline::PushDecl::of::<T>();
         self
     }
 
@@ -356,9 +366,9 @@ impl<'a> GraphicsPipelineBuilder<'a> {
         let layout = Layout::new(
             &shared,
             self.name,
-            &self.kinds,
+            self.kinds.as_deref(),
             &[],
-            self.push_constant_bytes,
+            self.push,
             vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
             &[self.vertex_spirv, self.fragment_spirv],
         )?;

@@ -393,10 +393,7 @@ impl Image {
             Residency::Upload,
         )?;
         // Buffers are at least 16 bytes: a tiny image fills only the start of its staging.
-        staging
-            .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")[..bytes.len()]
-            .copy_from_slice(bytes);
+        staging.write_mapped(0, bytes)?;
         ctx.submit(|rec| {
             rec.copy_buffer_to_image(&staging, self);
             Ok(())
@@ -416,12 +413,7 @@ impl Image {
             rec.copy_image_to_buffer(self, &readback);
             Ok(())
         })?;
-        let bytes = readback
-            .mapped_bytes()
-            .expect("read-back buffers are host-visible");
-        Ok(bytemuck::pod_collect_to_vec(
-            &bytes[..self.size_bytes() as usize],
-        ))
+        readback.read_mapped(0, self.size_bytes() as usize / std::mem::size_of::<T>())
     }
 }
 

@@ -1,16 +1,17 @@
-//! The compute-pipeline builder every pass uses: a pass declares its bindings (in binding
-//! order), its push-constant type and any specialisation constants once; dispatches then pass
-//! resources in the same order and the recorder writes the descriptors.
+//! The compute-pipeline builder every pass uses: a pass names its shader, its push-constant
+//! type and any specialisation constants; the descriptor-set layout comes from the shader
+//! (SPIR-V reflection), and dispatches bind resources by the shader's names (src/gpu/bind.rs).
 
 use std::sync::Arc;
 
 use ash::vk;
 
+use super::block::{check_block, ShaderBlock};
 use super::buffer::Buffer;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::{Image, Sampler};
-use super::reflect::{reflect, Access};
+use super::reflect::{reflect, Access, BlockLayout};
 
 /// The kind of resource a shader binding expects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,16 +67,45 @@ pub(crate) struct PipelineParts<'p> {
     pub(crate) bind_point: vk::PipelineBindPoint,
 }
 
+/// The push-constant struct a pass declares: its size, and the check of its members against
+/// the shader's block (`check_block`).
+#[derive(Clone, Copy)]
+pub(crate) struct PushDecl {
+    pub(crate) bytes: u32,
+    check: fn(&str, Option<&BlockLayout>) -> Result<(), String>,
+}
+
+impl PushDecl {
+    pub(crate) fn of<T: ShaderBlock>() -> PushDecl {
+        PushDecl {
+            bytes: std::mem::size_of::<T>() as u32,
+            check: check_block::<T>,
+        }
+    }
+}
+
+/// One binding of a pass's descriptor set, as its shaders declare it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Slot {
+    pub(crate) kind: BindingKind,
+    /// Over every stage that uses it: what the barriers are derived from.
+    pub(crate) access: Access,
+    /// The GLSL name a pass binds it by (`ReflectedBinding::name`).
+    pub(crate) name: String,
+    /// Bytes of a uniform block: a buffer bound to it must hold at least this many.
+    pub(crate) block_bytes: Option<u32>,
+}
+
 /// The descriptor-set and pipeline layouts of a pass, built by one code path for compute and
-/// graphics pipelines from the bindings and push-constant struct the pass declares, after
-/// checking both against what its shaders declare (SPIR-V reflection): a binding list that
-/// disagrees with its shader is an error when the pipeline is built, not a validation
-/// message (or undefined behaviour) when it runs. The shaders' access (readonly / writeonly)
-/// is kept for the recorder to derive barriers from.
+/// graphics pipelines from what its shaders declare (SPIR-V reflection): set-0 bindings
+/// 0, 1, … with their names, kinds and access (readonly / writeonly, kept for the recorder to
+/// derive barriers from), and the push-constant block, whose size must be the pass's struct's.
+/// A pass may still declare its binding kinds (`bindings`, `uniform`), which are then checked
+/// against the shaders: a list that disagrees is an error when the pipeline is built, not a
+/// validation message (or undefined behaviour) when it runs.
 pub(crate) struct Layout {
     shared: Arc<DeviceShared>,
-    pub(crate) kinds: Vec<BindingKind>,
-    pub(crate) access: Vec<Access>,
+    pub(crate) slots: Vec<Slot>,
     pub(crate) push_constant_bytes: u32,
     pub(crate) stages: vk::ShaderStageFlags,
     pub(crate) set_layout: vk::DescriptorSetLayout,
@@ -86,12 +116,13 @@ impl Layout {
     pub(crate) fn new(
         shared: &Arc<DeviceShared>,
         name: &str,
-        kinds: &[BindingKind],
+        declared: Option<&[BindingKind]>,
         uniform_bytes: &[(u32, u32)],
-        push_constant_bytes: u32,
+        push: PushDecl,
         stages: vk::ShaderStageFlags,
         modules: &[&[u8]],
     ) -> GpuResult<Layout> {
+        let push_constant_bytes = push.bytes;
         let usage = |message: String| GpuError::Usage {
             pass: name.to_string(),
             message,
@@ -102,24 +133,23 @@ impl Layout {
                 "{push_constant_bytes} bytes of push constants in pass \"{name}\" (limit {max_push})"
             )));
         }
-        let access = check_against_shaders(kinds, uniform_bytes, push_constant_bytes, modules)
-            .map_err(usage)?;
+        let slots = slots_of_shaders(declared, uniform_bytes, push, modules).map_err(usage)?;
         let mut out = Layout {
             shared: shared.clone(),
-            kinds: kinds.to_vec(),
-            access,
+            slots,
             push_constant_bytes,
             stages,
             set_layout: vk::DescriptorSetLayout::null(),
             layout: vk::PipelineLayout::null(),
         };
-        let layout_bindings: Vec<_> = kinds
+        let layout_bindings: Vec<_> = out
+            .slots
             .iter()
             .enumerate()
-            .map(|(i, kind)| {
+            .map(|(i, slot)| {
                 vk::DescriptorSetLayoutBinding::default()
                     .binding(i as u32)
-                    .descriptor_type(kind.descriptor_type())
+                    .descriptor_type(slot.kind.descriptor_type())
                     .descriptor_count(1)
                     .stage_flags(stages)
             })
@@ -161,33 +191,51 @@ impl Drop for Layout {
     }
 }
 
-/// The declared bindings (0, 1, … of set 0), uniform-block sizes (binding, bytes) and
-/// push-constant size against the union of what `modules` declare; returns each binding's
-/// access over all stages.
-fn check_against_shaders(
-    kinds: &[BindingKind],
+impl Layout {
+    /// The binding named `name`, or what names there are.
+    pub(crate) fn slot(&self, name: &str) -> Result<usize, String> {
+        self.slots
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = self.slots.iter().map(|s| s.name.as_str()).collect();
+                format!(
+                    "the shader has no binding named \"{name}\" (its bindings: {})",
+                    names.join(", ")
+                )
+            })
+    }
+}
+
+/// The bindings 0, 1, … of set 0 over every module in `modules` (access joined over the
+/// stages), checked against the declared kinds (when the pass declares them) and uniform-block
+/// sizes (binding, bytes), and the push-constant block against the pass's struct.
+fn slots_of_shaders(
+    declared: Option<&[BindingKind]>,
     uniform_bytes: &[(u32, u32)],
-    push_constant_bytes: u32,
+    push: PushDecl,
     modules: &[&[u8]],
-) -> Result<Vec<Access>, String> {
-    let mut found: Vec<Option<(BindingKind, Access)>> = vec![None; kinds.len()];
-    let mut push = 0;
+) -> Result<Vec<Slot>, String> {
+    let mut found: std::collections::BTreeMap<u32, Slot> = Default::default();
+    let mut push_block = None;
     for spirv in modules {
         let r = reflect(spirv)?;
-        push = push.max(r.push_constant_bytes);
+        push_block = push_block.or(r.push_constants);
         for b in r.bindings {
-            let Some(slot) = found.get_mut(b.binding as usize) else {
-                return Err(format!(
-                    "the shader uses binding {} but the pass declares {} bindings",
-                    b.binding,
-                    kinds.len()
-                ));
-            };
-            if b.kind != kinds[b.binding as usize] {
-                return Err(format!(
-                    "binding {} is a {:?} in the shader, declared as {:?}",
-                    b.binding, b.kind, kinds[b.binding as usize]
-                ));
+            if let Some(kinds) = declared {
+                let Some(kind) = kinds.get(b.binding as usize) else {
+                    return Err(format!(
+                        "the shader uses binding {} but the pass declares {} bindings",
+                        b.binding,
+                        kinds.len()
+                    ));
+                };
+                if b.kind != *kind {
+                    return Err(format!(
+                        "binding {} is a {:?} in the shader, declared as {kind:?}",
+                        b.binding, b.kind
+                    ));
+                }
             }
             if let (Some(block), Some(&(_, bytes))) = (
                 &b.block,
@@ -200,25 +248,49 @@ fn check_against_shaders(
                     ));
                 }
             }
-            *slot = Some(match *slot {
-                Some((k, a)) if a != b.access => (k, Access::ReadWrite),
-                _ => (b.kind, b.access),
-            });
+            let slot = Slot {
+                kind: b.kind,
+                access: b.access,
+                name: b.name,
+                block_bytes: b.block.map(|block| block.bytes),
+            };
+            match found.get_mut(&b.binding) {
+                None => {
+                    found.insert(b.binding, slot);
+                }
+                Some(seen) if seen.kind != slot.kind || seen.name != slot.name => {
+                    return Err(format!(
+                        "binding {} is {} {:?} in one stage and {} {:?} in another",
+                        b.binding, seen.name, seen.kind, slot.name, slot.kind
+                    ));
+                }
+                Some(seen) if seen.access != slot.access => seen.access = Access::ReadWrite,
+                Some(_) => {}
+            }
         }
     }
-    if push != push_constant_bytes {
-        return Err(format!(
-            "the shader's push-constant block is {push} bytes, the pass's struct {push_constant_bytes}"
-        ));
-    }
-    found
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            f.map(|(_, a)| a)
-                .ok_or(format!("binding {i} is declared but the shader has none"))
+    (push.check)("push-constant", push_block.as_ref())?;
+    let count = declared.map_or(found.len(), <[BindingKind]>::len);
+    let slots: Vec<Slot> = (0..count as u32)
+        .map(|i| {
+            found.remove(&i).ok_or(match declared {
+                Some(_) => format!("binding {i} is declared but the shader has none"),
+                None => format!(
+                    "the shader's set-0 bindings skip {i} (ocular binds 0, 1, 2, … without gaps)"
+                ),
+            })
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    let mut names: Vec<&str> = slots
+        .iter()
+        .map(|s| s.name.as_str())
+        .filter(|n| !n.is_empty())
+        .collect();
+    names.sort_unstable();
+    if let Some(w) = names.windows(2).find(|w| w[0] == w[1]) {
+        return Err(format!("two bindings are named \"{}\"", w[0]));
+    }
+    Ok(slots)
 }
 
 pub struct ComputePipeline {
@@ -230,10 +302,11 @@ pub struct ComputePipeline {
 pub struct ComputePipelineBuilder<'a> {
     name: &'a str,
     spirv: &'a [u8],
-    kinds: Vec<BindingKind>,
+    /// Binding kinds the pass declares, if it does (checked against the shader).
+    kinds: Option<Vec<BindingKind>>,
     /// (binding, bytes) of the uniform blocks declared with a struct.
     uniform_bytes: Vec<(u32, u32)>,
-    push_constant_bytes: u32,
+    push: PushDecl,
     specialization: Vec<(u32, u32)>,
 }
 
@@ -243,9 +316,9 @@ impl ComputePipeline {
         ComputePipelineBuilder {
             name,
             spirv,
-            kinds: Vec::new(),
+            kinds: None,
             uniform_bytes: Vec::new(),
-            push_constant_bytes: 0,
+            push: PushDecl::of::<()>(),
             specialization: Vec::new(),
         }
     }
@@ -270,26 +343,32 @@ impl ComputePipeline {
 }
 
 impl<'a> ComputePipelineBuilder<'a> {
-    /// Declares the next bindings of set 0 (from 0, 1, 2, …), in order.
+    /// Optional: declares the next bindings of set 0 (from 0, 1, 2, …), in order, to be
+    /// checked against the shader when the pipeline is built. Without it the layout is the
+    /// shader's (passes bind by name and need no list).
     pub fn bindings(mut self, kinds: &[BindingKind]) -> Self {
-        self.kinds.extend_from_slice(kinds);
+        self.kinds
+            .get_or_insert_with(Vec::new)
+            .extend_from_slice(kinds);
         self
     }
 
-    /// Declares the next binding as a uniform buffer holding a `T` (a `#[repr(C)]` Pod struct
-    /// that mirrors the GLSL block with std140 layout); the block's size is checked against
-    /// the shader's when the pipeline is built.
+    /// Optional, with `bindings`: declares the next binding as a uniform buffer holding a `T`
+    /// (a `#[repr(C)]` Pod struct that mirrors the GLSL block with std140 layout); the block's
+    /// size is checked against the shader's when the pipeline is built.
     pub fn uniform<T: bytemuck::Pod>(mut self) -> Self {
+        let kinds = self.kinds.get_or_insert_with(Vec::new);
         self.uniform_bytes
-            .push((self.kinds.len() as u32, std::mem::size_of::<T>() as u32));
-        self.kinds.push(BindingKind::UniformBuffer);
+            .push((kinds.len() as u32, std::mem::size_of::<T>() as u32));
+        kinds.push(BindingKind::UniformBuffer);
         self
     }
 
-    /// Declares the push-constant block as the bytes of `T` (a `#[repr(C)]` Pod struct that
-    /// mirrors the GLSL block with std430 layout).
-    pub fn push_constants<T: bytemuck::Pod>(mut self) -> Self {
-        self.push_constant_bytes = std::mem::size_of::<T>() as u32;
+    /// Declares the push-constant block as the bytes of `T`: a struct that mirrors the GLSL
+    /// block with std430 layout, made with `shader_block!` so that its members are checked
+    /// against the shader's when the pipeline is built (a plain `u32` or array: its size).
+    pub fn push_constants<T: ShaderBlock>(mut self) -> Self {
+        self.push = PushDecl::of::<T>();
         self
     }
 
@@ -311,9 +390,9 @@ impl<'a> ComputePipelineBuilder<'a> {
         let layout = Layout::new(
             &shared,
             self.name,
-            &self.kinds,
+            self.kinds.as_deref(),
             &self.uniform_bytes,
-            self.push_constant_bytes,
+            self.push,
             vk::ShaderStageFlags::COMPUTE,
             &[self.spirv],
         )?;

@@ -1,8 +1,8 @@
-//! What a SPIR-V module declares, read from its words: the set-0 bindings (kind and whether
-//! the shader reads, writes or both) and the size of its push-constant block. Pipelines check
-//! the bindings and push-constant struct a pass declares in Rust against it when they are
-//! built, and the recorder derives barriers from the access (src/gpu/access.rs), so a binding
-//! list can no longer disagree with its shader unnoticed.
+//! What a SPIR-V module declares, read from its words: the set-0 bindings (their names, kind
+//! and whether the shader reads, writes or both) and the size of its push-constant block.
+//! Pipelines take their descriptor-set layout from it, passes bind resources by the names it
+//! reports (src/gpu/bind.rs), and the recorder derives barriers from the access
+//! (src/gpu/access.rs): the binding order is written once, in the shader.
 
 use super::pipeline::BindingKind;
 
@@ -28,6 +28,10 @@ impl Access {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ReflectedBinding {
     pub binding: u32,
+    /// The GLSL name a pass binds it by: a buffer or uniform block's block name (`Radii` in
+    /// `buffer Radii { vec4 radii[]; }`), an image's or sampler's variable name. Empty when
+    /// the module's debug names were stripped.
+    pub name: String,
     pub kind: BindingKind,
     pub access: Access,
     /// Uniform buffers: the block's layout (a Rust struct that mirrors it is checked against it).
@@ -53,6 +57,7 @@ pub struct Reflection {
 }
 
 mod op {
+    pub const NAME: u32 = 5;
     pub const MEMBER_NAME: u32 = 6;
     pub const DECORATE: u32 = 71;
     pub const MEMBER_DECORATE: u32 = 72;
@@ -111,6 +116,8 @@ struct Module {
     member_decorations: std::collections::HashMap<(u32, u32, u32), u32>,
     /// (variable, pointer type, storage class)
     variables: Vec<(u32, u32, u32)>,
+    /// id → debug name (OpName).
+    names: std::collections::HashMap<u32, String>,
     /// (struct, member) → debug name.
     member_names: std::collections::HashMap<(u32, u32), String>,
 }
@@ -146,6 +153,9 @@ fn parse(mut words: &[u32]) -> Result<Module, String> {
         match opcode {
             op::DECORATE => {
                 m.decorations.insert((at(0), at(1)), at(2));
+            }
+            op::NAME if a.len() > 1 => {
+                m.names.insert(at(0), literal_string(&a[1..]));
             }
             op::MEMBER_NAME if a.len() > 2 => {
                 m.member_names
@@ -301,6 +311,13 @@ impl Module {
                 continue;
             }
             let mut block = None;
+            // Blocks by their block name (instances are often anonymous), opaque resources
+            // by their variable name.
+            let named = match storage {
+                class::UNIFORM_CONSTANT => var,
+                _ => pointee,
+            };
+            let name = self.names.get(&named).cloned().unwrap_or_default();
             let (kind, access) = match (storage, self.types.get(&pointee)) {
                 (class::STORAGE_BUFFER, _) => {
                     (BindingKind::StorageBuffer, self.block_access(var, pointee))
@@ -330,6 +347,7 @@ impl Module {
             };
             out.bindings.push(ReflectedBinding {
                 binding,
+                name,
                 kind,
                 access,
                 block,
@@ -353,36 +371,37 @@ mod tests {
     use super::*;
 
     /// Checked against the GLSL source of the convolution: a sampler, four read-only fragment
-    /// ranges (1, 7, 8, 9), three read-only list buffers, a write-only output image and the
-    /// read-only field table (6), the frame's uniform block (10), under 16 bytes of band push
-    /// constants.
+    /// ranges (1, 9, 10, 11: `FRAGMENT_BUFFERS`), three read-only list buffers, a write-only
+    /// output image, the read-only field table (6), band table (7) and atlas (8), the frame's
+    /// uniform block (12), under 8 bytes of band push constants; blocks by their block name,
+    /// the sampler and the image by their variable name.
     #[test]
     fn convolve_shader_reflects_as_written() {
         let r = reflect(crate::shaders::RENDER_SPLAT_CONVOLVE_COMP).unwrap();
         assert_eq!(r.push_constant_bytes, 8);
-        let got: Vec<(u32, BindingKind, Access)> = r
+        let got: Vec<(u32, &str, BindingKind, Access)> = r
             .bindings
             .iter()
-            .map(|b| (b.binding, b.kind, b.access))
+            .map(|b| (b.binding, b.name.as_str(), b.kind, b.access))
             .collect();
         use Access::*;
         use BindingKind::*;
         assert_eq!(
             got,
             vec![
-                (0, SampledImage, Read),
-                (1, StorageBuffer, Read),
-                (2, StorageBuffer, Read),
-                (3, StorageBuffer, Read),
-                (4, StorageBuffer, Read),
-                (5, StorageImage, Write),
-                (6, StorageBuffer, Read),
-                (7, StorageBuffer, Read),
-                (8, StorageBuffer, Read),
-                (9, StorageBuffer, Read),
-                (10, StorageBuffer, Read),
-                (11, StorageBuffer, Read),
-                (12, UniformBuffer, Read),
+                (0, "psf_texture", SampledImage, Read),
+                (1, "Fragments0", StorageBuffer, Read),
+                (2, "Counts", StorageBuffer, Read),
+                (3, "Offsets", StorageBuffer, Read),
+                (4, "Entries", StorageBuffer, Read),
+                (5, "color_out", StorageImage, Write),
+                (6, "Field", StorageBuffer, Read),
+                (7, "BandTable", StorageBuffer, Read),
+                (8, "Atlas", StorageBuffer, Read),
+                (9, "Fragments1", StorageBuffer, Read),
+                (10, "Fragments2", StorageBuffer, Read),
+                (11, "Fragments3", StorageBuffer, Read),
+                (12, "FrameUniform", UniformBuffer, Read),
             ]
         );
         // the frame block: 20 four-byte scalars, std140-packed like repr(C)

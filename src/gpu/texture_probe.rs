@@ -1,14 +1,13 @@
 //! Samples a 3D image through a sampler at arbitrary points on the GPU and reads the values
 //! back: what a shader sees, for comparison with CPU references.
 
-use super::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Residency, Sampler,
-};
+use super::{shader_block, Buffer, ComputePipeline, Context, GpuResult, Image, Residency, Sampler};
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Push {
-    count: u32,
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct Push {
+        count: u32,
+    }
 }
 
 pub struct TextureProbe {
@@ -19,11 +18,6 @@ impl TextureProbe {
     pub fn new(ctx: &Context) -> GpuResult<TextureProbe> {
         let pipeline =
             ComputePipeline::builder("texture probe", crate::shaders::GPU_TEXTURE_PROBE_COMP)
-                .bindings(&[
-                    BindingKind::SampledImage,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                ])
                 .push_constants::<Push>()
                 .build(ctx)?;
         Ok(TextureProbe { pipeline })
@@ -48,18 +42,14 @@ impl TextureProbe {
         let groups = (points.len() as u32).div_ceil(64).clamp(1, 65_535);
         ctx.submit(|rec| {
             rec.begin_pass("texture probe");
-            rec.dispatch(
-                &self.pipeline,
-                &[
-                    Binding::Sampled(image, sampler),
-                    Binding::Buffer(&input),
-                    Binding::Buffer(&output),
-                ],
-                &Push {
+            rec.compute(&self.pipeline)
+                .read("volume", (image, sampler))
+                .read("Points", &input)
+                .write("Samples", &output)
+                .push(&Push {
                     count: points.len() as u32,
-                },
-                [groups, 1, 1],
-            )
+                })
+                .dispatch([groups, 1, 1])
         })?;
         let mut values: Vec<[f32; 4]> = output.read(ctx)?;
         values.truncate(points.len());

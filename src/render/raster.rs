@@ -13,7 +13,7 @@
 //! through the same `prepare` (uniforms through a persistent mapping) and `record`.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
+    shader_block, Buffer, ComputePipeline, Context, DepthCompare, Edge, Framebuffer,
     GraphicsPipeline, Image, ImageUsage, Recorder, Residency, Sampler, TexelFormat, Timings,
     VertexAttribute, VertexFormat,
 };
@@ -85,22 +85,24 @@ struct FrameUniform {
     lights: [LightGpu; MAX_LIGHTS],
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct MaterialPush {
-    albedo: [f32; 4],
-    emission: [f32; 4],
-    /// x, y: the nearest and farthest view depth (m) of the batch's box within the clip range
-    /// (see raster_shade.glsl).
-    depth_range_m: [f32; 4],
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct MaterialPush {
+        albedo: [f32; 4],
+        emission: [f32; 4],
+        /// x, y: the nearest and farthest view depth (m) of the batch's box within the clip range
+        /// (see raster_shade.glsl).
+        depth_range_m: [f32; 4],
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ResolvePush {
-    width: u32,
-    height: u32,
-    samples: u32,
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    struct ResolvePush {
+        width: u32,
+        height: u32,
+        samples: u32,
+    }
 }
 
 /// Scene data uploaded once and reused while the same scene is rendered.
@@ -151,7 +153,6 @@ impl Rasterizer {
         let pipeline = Self::pipeline(ctx, false)?;
         let peel = Self::pipeline(ctx, true)?;
         let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
-            .bindings(&[BindingKind::SampledImage, BindingKind::StorageBuffer])
             .push_constants::<ResolvePush>()
             .build(ctx)?;
         let white = Image::new_2d(
@@ -183,22 +184,13 @@ impl Rasterizer {
     }
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
-    /// layer's depth).
+    /// layer's depth, `previous_depth` in glsl/render/raster_peel.frag).
     fn pipeline(ctx: &Context, peel: bool) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
         let (name, fragment) = if peel {
             ("raster peel", crate::shaders::RENDER_RASTER_PEEL_FRAG)
         } else {
             ("raster", crate::shaders::RENDER_RASTER_FRAG)
-        };
-        let bindings: &[BindingKind] = if peel {
-            &[
-                BindingKind::UniformBuffer,
-                BindingKind::SampledImage,
-                BindingKind::SampledImage,
-            ]
-        } else {
-            &[BindingKind::UniformBuffer, BindingKind::SampledImage]
         };
         Ok(
             GraphicsPipeline::builder(name, crate::shaders::RENDER_RASTER_VERT, fragment)
@@ -222,7 +214,6 @@ impl Rasterizer {
                         },
                     ],
                 )
-                .bindings(bindings)
                 .push_constants::<MaterialPush>()
                 .samples(MSAA_SAMPLES)
                 .color_target(TexelFormat::Rgba32Float, true)
@@ -506,15 +497,11 @@ impl Rasterizer {
             Ok(())
         })?;
         let pixels = width as usize * height as usize;
-        fn mapped(b: &Buffer, bytes: usize) -> &[u8] {
-            &b.mapped_bytes()
-                .expect("read-back buffers are host-visible")[..bytes]
-        }
         Ok(Frame {
             width,
             height,
-            color: bytemuck::pod_collect_to_vec(mapped(color_readback, pixels * 16)),
-            depth_m: bytemuck::pod_collect_to_vec(mapped(depth_readback, pixels * 4)),
+            color: color_readback.read_mapped(0, pixels)?,
+            depth_m: depth_readback.read_mapped(0, pixels)?,
             timings,
         })
     }
@@ -583,9 +570,7 @@ impl Rasterizer {
             uniform.ambient[3] = gap_d;
         }
         self.uniforms
-            .mapped_bytes_mut()
-            .expect("upload buffers are host-visible")[..std::mem::size_of::<FrameUniform>()]
-            .copy_from_slice(bytemuck::bytes_of(&uniform));
+            .write_mapped(0, std::slice::from_ref(&uniform))?;
         Ok(())
     }
 
@@ -643,14 +628,19 @@ impl Rasterizer {
                     [lo as f32, hi as f32, 0.0, 0.0]
                 },
             };
-            let bindings = [
-                Binding::Buffer(&self.uniforms),
-                Binding::Sampled(texture, &self.texture_sampler),
-                Binding::Sampled(&targets.previous_depth, &self.point_sampler),
-            ];
+            let mut bound = pipeline
+                .bind()
+                .read("Frame", &self.uniforms)
+                .read("albedo_map", (texture, &self.texture_sampler));
+            if peel {
+                bound = bound.read(
+                    "previous_depth",
+                    (&targets.previous_depth, &self.point_sampler),
+                );
+            }
             rec.draw_indexed(
                 pipeline,
-                &bindings[..if peel { 3 } else { 2 }],
+                &bound.finish()?,
                 &push,
                 &gpu_scene.vertices,
                 &gpu_scene.indices,
@@ -660,19 +650,15 @@ impl Rasterizer {
         }
         rec.end_render_pass()?;
         rec.begin_pass("depth resolve");
-        rec.dispatch(
-            &self.resolve,
-            &[
-                Binding::Sampled(&targets.view_depth_ms, &self.point_sampler),
-                Binding::Buffer(&targets.depth),
-            ],
-            &ResolvePush {
+        rec.compute(&self.resolve)
+            .read("view_depth", (&targets.view_depth_ms, &self.point_sampler))
+            .write("Depth", &targets.depth)
+            .push(&ResolvePush {
                 width,
                 height,
                 samples: MSAA_SAMPLES,
-            },
-            [width.div_ceil(8), height.div_ceil(8), 1],
-        )?;
+            })
+            .dispatch([width.div_ceil(8), height.div_ceil(8), 1])?;
         // The MSAA targets live as long as the framebuffers that use them.
         let _ = (&targets.color_ms, &targets.depth_ms);
         Ok(())

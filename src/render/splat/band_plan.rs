@@ -2,19 +2,22 @@
 //! the prefix sum, and writes the band table the list passes read (their ranges and the
 //! indirect dispatches of tile sort and convolve). See glsl/render/splat/band_plan.comp.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
 
-/// Push constants of the band-plan dispatch. Mirrors `BandPlanPush` in
-/// glsl/render/splat/band_plan.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct BandPlanPush {
-    pub tiles_x: u32,
-    pub tiles: u32,
-    /// Entries the list buffer holds.
-    pub capacity: u32,
-    /// Slots recorded after this dispatch.
-    pub slots: u32,
+use super::Resources;
+
+shader_block! {
+    /// Push constants of the band-plan dispatch. Mirrors `BandPlanPush` in
+    /// glsl/render/splat/band_plan.comp.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct BandPlanPush {
+        pub tiles_x: u32,
+        pub tiles: u32,
+        /// Entries the list buffer holds.
+        pub capacity: u32,
+        /// Slots recorded after this dispatch.
+        pub slots: u32,
+    }
 }
 
 pub(super) struct BandPlanPass {
@@ -25,34 +28,29 @@ impl BandPlanPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("band plan", crate::shaders::RENDER_SPLAT_BAND_PLAN_COMP)
-                .bindings(&[
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                ])
                 .push_constants::<BandPlanPush>()
                 .build(ctx)?;
         Ok(BandPlanPass { pipeline })
     }
 
-    /// Plans `push.slots` slots of `table` from `counts` and `offsets` (tiles + 1 each).
+    /// Plans `slots` slots of the band table for a list buffer of `capacity` entries, from
+    /// the tile counts and offsets (tiles + 1 each).
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        push: &BandPlanPush,
-        counts: &Buffer,
-        offsets: &Buffer,
-        table: &Buffer,
+        r: &Resources<'_>,
+        (slots, capacity): (u32, u32),
     ) -> GpuResult<()> {
-        rec.dispatch(
-            &self.pipeline,
-            &[
-                Binding::Buffer(counts),
-                Binding::Buffer(offsets),
-                Binding::Buffer(table),
-            ],
-            push,
-            [1, 1, 1],
-        )
+        rec.compute(&self.pipeline)
+            .read("Counts", &r.frame.counts)
+            .read("Offsets", &r.frame.offsets)
+            .write("BandTable", &r.frame.band_table)
+            .push(&BandPlanPush {
+                tiles_x: r.frame.tiles_x,
+                tiles: r.frame.tiles_x * r.frame.tiles_y,
+                capacity,
+                slots,
+            })
+            .dispatch([1, 1, 1])
     }
 }

@@ -4,6 +4,8 @@
 //! below); [`plan_bands`] is the same rule on the host, which sizes the list buffer and the
 //! slots of a frame the GPU could not plan, and whose band count the GPU's must then match.
 
+use crate::gpu::shader_block;
+
 use super::ENTRY_BYTES;
 
 /// A range of whole tile rows processed together, and where its entries start in the global
@@ -16,14 +18,22 @@ pub(crate) struct Band {
     pub entries: u64,
 }
 
-/// Push constants of the list passes (tile fill, tile sort, convolve): which slot of the band
-/// table they work on. Mirrors `BandPush` in glsl/common/band.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct BandPush {
-    pub slot: u32,
-    /// Entries the list buffer holds: lists past it are not touched (the host re-plans).
-    pub entry_capacity: u32,
+shader_block! {
+    /// Push constants of the list passes (tile fill, tile sort, convolve): which slot of the band
+    /// table they work on. Mirrors `BandPush` in glsl/common/band.glsl.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(crate) struct BandPush {
+        pub slot: u32,
+        /// Entries the list buffer holds: lists past it are not touched (the host re-plans).
+        pub entry_capacity: u32,
+    }
+}
+
+/// One band slot as the list passes record it: its push constants and the list buffer.
+#[derive(Clone, Copy)]
+pub(super) struct BandSlot<'a> {
+    pub push: BandPush,
+    pub entries: &'a crate::gpu::Buffer,
 }
 
 /// The band table the GPU plans (glsl/render/splat/band_plan.comp): a 32-byte header (band

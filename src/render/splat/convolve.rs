@@ -1,13 +1,10 @@
 //! Convolution pass: front-to-back blending of each tile's sorted fragments through the PSF
 //! texture. See glsl/render/splat/convolve.comp.
 
-use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Sampler,
-};
+use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
 
-use super::bands::{dispatch_offset, BandPush};
-use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::{FrameBlock, FrameUniform};
+use super::bands::{dispatch_offset, BandPush, BandSlot};
+use super::Resources;
 
 pub(super) struct ConvolvePass {
     pipeline: ComputePipeline,
@@ -25,18 +22,6 @@ impl ConvolvePass {
         per_fragment: bool,
         visit_slots: bool,
     ) -> GpuResult<Self> {
-        let bindings = kinds_with_fragments(
-            &[BindingKind::SampledImage],
-            &[
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageImage,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-            ],
-        );
         let builder = if visit_slots {
             ComputePipeline::builder(
                 "convolve",
@@ -47,8 +32,6 @@ impl ConvolvePass {
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
         };
         let pipeline = builder
-            .bindings(&bindings)
-            .uniform::<FrameUniform>()
             .push_constants::<BandPush>()
             .specialize(0, tile_size)
             .specialize(1, u32::from(off_axis))
@@ -56,41 +39,27 @@ impl ConvolvePass {
         Ok(ConvolvePass { pipeline })
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// Blends the band in `band.push.slot` of the band table into the output image, one
+    /// workgroup per tile, dispatched as the table says.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        frame: FrameBlock<'_>,
-        band: &BandPush,
-        bands: &Buffer,
-        // the PSF texture, its sampler and its layout (glsl/common/atlas.glsl)
-        psf: (&Image, &Sampler, &Buffer),
-        field_table: &Buffer,
-        fragments: &FragmentStore,
-        counts: &Buffer,
-        offsets: &Buffer,
-        entries: &Buffer,
-        output: &Image,
+        r: &Resources<'_>,
+        band: &BandSlot<'_>,
     ) -> GpuResult<()> {
-        let mut bindings = fragments.bind_with(
-            &[Binding::Sampled(psf.0, psf.1)],
-            &[
-                Binding::Buffer(counts),
-                Binding::Buffer(offsets),
-                Binding::Buffer(entries),
-                Binding::Storage(output),
-                Binding::Buffer(field_table),
-                Binding::Buffer(bands),
-                Binding::Buffer(psf.2),
-            ],
-        );
-        bindings.push(frame.binding());
-        rec.dispatch_indirect(
-            &self.pipeline,
-            &bindings,
-            band,
-            bands,
-            dispatch_offset(band.slot),
-        )
+        let table = &r.frame.band_table;
+        rec.compute(&self.pipeline)
+            .read("psf_texture", (r.texture, r.sampler))
+            .read("Atlas", r.atlas)
+            .read("Field", r.field_table)
+            .read("Fragments", &r.frame.fragments)
+            .read("Counts", &r.frame.counts)
+            .read("Offsets", &r.frame.offsets)
+            .read("Entries", band.entries)
+            .read("BandTable", table)
+            .write("color_out", &r.frame.color_out)
+            .read("FrameUniform", r.block.buffer)
+            .push(&band.push)
+            .dispatch_indirect(table, dispatch_offset(band.push.slot))
     }
 }

@@ -2,13 +2,15 @@
 //! See glsl/render/splat/fragments.comp.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
+    shader_block, Bindable, Binding, Buffer, ComputePipeline, Context, GpuResult, Recorder,
+    Residency,
 };
 
-use super::{FrameBlock, FrameUniform, FRAGMENT_BYTES};
+use super::{Resources, FRAGMENT_BYTES};
 
 /// The frame's fragments: one buffer, bound to every pass as [`FRAGMENT_CHUNKS`] consecutive
-/// ranges (`FRAGMENT_BUFFERS` in glsl/common/splat.glsl). A 3840×2160 frame holds 380 MiB of
+/// ranges (`FRAGMENT_BUFFERS` in glsl/common/splat.glsl: blocks `Fragments0` … `Fragments3`,
+/// which a pass binds at once as "Fragments"). A 3840×2160 frame holds 380 MiB of
 /// fragments; lavapipe binds at most 128 MiB per storage buffer, so a frame is split into
 /// ranges the device can bind instead of being refused.
 pub(super) struct FragmentStore {
@@ -52,7 +54,7 @@ impl FragmentStore {
 
     /// The four ranges, first to last. Ranges past the data repeat the first one (a shader
     /// never indexes them: its fragment indices stop at the frame's pixel count).
-    pub fn bindings(&self) -> [Binding<'_>; FRAGMENT_CHUNKS as usize] {
+    pub fn ranges(&self) -> [Binding<'_>; FRAGMENT_CHUNKS as usize] {
         let total = self.buffer.size_bytes();
         let chunk = u64::from(self.per_chunk) * FRAGMENT_BYTES;
         let range = |k: u64| {
@@ -65,36 +67,13 @@ impl FragmentStore {
         };
         [range(0), range(1), range(2), range(3)]
     }
-
-    /// `before` (the bindings ahead of the first range, in the pass's binding order), the
-    /// first range, `after`, then the other three ranges: how every pass declares them.
-    pub fn bind_with<'a>(
-        &'a self,
-        before: &[Binding<'a>],
-        after: &[Binding<'a>],
-    ) -> Vec<Binding<'a>> {
-        let [first, rest @ ..] = self.bindings();
-        let mut all = before.to_vec();
-        all.push(first);
-        all.extend_from_slice(after);
-        all.extend_from_slice(&rest);
-        all
-    }
 }
 
-/// The binding kinds of a pass whose fragment ranges sit after `before` and before `after`.
-pub(super) fn kinds_with_fragments(
-    before: &[BindingKind],
-    after: &[BindingKind],
-) -> Vec<BindingKind> {
-    let mut all = before.to_vec();
-    all.push(BindingKind::StorageBuffer);
-    all.extend_from_slice(after);
-    all.extend(std::iter::repeat_n(
-        BindingKind::StorageBuffer,
-        FRAGMENT_CHUNKS as usize - 1,
-    ));
-    all
+/// Binds the four ranges as `Fragments0` … `Fragments3`.
+impl<'a> Bindable<'a> for &'a FragmentStore {
+    fn resources(self) -> impl IntoIterator<Item = (Option<usize>, Binding<'a>)> {
+        self.ranges().resources()
+    }
 }
 
 /// How hidden-layer fragments are judged (`FragmentsPush`).
@@ -110,14 +89,15 @@ pub(super) struct HiddenLight {
     pub parallax_px_per_d: f32,
 }
 
-/// Push constants of the fragments pass. Mirrors `FragmentsPush` in
-/// glsl/render/splat/fragments.comp; see [`HiddenLight`].
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct FragmentsPush {
-    pub pupil_visibility: u32,
-    pub focus_d: f32,
-    pub parallax_px_per_d: f32,
+shader_block! {
+    /// Push constants of the fragments pass. Mirrors `FragmentsPush` in
+    /// glsl/render/splat/fragments.comp; see [`HiddenLight`].
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct FragmentsPush {
+        pub pupil_visibility: u32,
+        pub focus_d: f32,
+        pub parallax_px_per_d: f32,
+    }
 }
 
 pub(super) struct FragmentsPass {
@@ -128,51 +108,30 @@ impl FragmentsPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("fragments", crate::shaders::RENDER_SPLAT_FRAGMENTS_COMP)
-                .bindings(&kinds_with_fragments(
-                    &[
-                        BindingKind::StorageImage,
-                        BindingKind::StorageImage,
-                        BindingKind::StorageBuffer,
-                    ],
-                    &[BindingKind::StorageBuffer],
-                ))
-                .uniform::<FrameUniform>()
                 .push_constants::<FragmentsPush>()
                 .build(ctx)?;
         Ok(FragmentsPass { pipeline })
     }
 
-    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        frame: FrameBlock<'_>,
-        color: &Image,
-        depth: &Image,
-        radii: &Buffer,
-        field_table: &Buffer,
-        fragments: &FragmentStore,
+        r: &Resources<'_>,
         hidden: HiddenLight,
     ) -> GpuResult<()> {
-        let mut bindings = fragments.bind_with(
-            &[
-                Binding::Storage(color),
-                Binding::Storage(depth),
-                Binding::Buffer(radii),
-            ],
-            &[Binding::Buffer(field_table)],
-        );
-        bindings.push(frame.binding());
-        let p = frame.values;
-        rec.dispatch(
-            &self.pipeline,
-            &bindings,
-            &FragmentsPush {
+        let p = r.block.values;
+        rec.compute(&self.pipeline)
+            .read("color_in", &r.frame.color_in)
+            .read("depth_in", &r.frame.depth_in)
+            .read("Radii", r.radii)
+            .read("Field", r.field_table)
+            .write("Fragments", &r.frame.fragments)
+            .read("FrameUniform", r.block.buffer)
+            .push(&FragmentsPush {
                 pupil_visibility: u32::from(hidden.pupil_visibility),
                 focus_d: hidden.focus_d,
                 parallax_px_per_d: hidden.parallax_px_per_d,
-            },
-            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
-        )
+            })
+            .dispatch([p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1])
     }
 }

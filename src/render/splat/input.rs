@@ -7,7 +7,7 @@
 //! hands its depth to the next peel on the GPU. Both feed the same passes after this.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
+    shader_block, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
 };
 use crate::{Error, Result};
 
@@ -69,17 +69,18 @@ pub(super) struct Staging {
     depth: Buffer,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct InputPush {
-    pub width: u32,
-    pub height: u32,
-    /// Which layer of the stack this dispatch writes (its rows start at layer · height).
-    pub layer: u32,
-    /// 1 where another layer follows and reads this one's depth.
-    pub write_previous: u32,
-    pub near_m: f32,
-    pub far_m: f32,
+shader_block! {
+    #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct InputPush {
+        pub width: u32,
+        pub height: u32,
+        /// Which layer of the stack this dispatch writes (its rows start at layer · height).
+        pub layer: u32,
+        /// 1 where another layer follows and reads this one's depth.
+        pub write_previous: u32,
+        pub near_m: f32,
+        pub far_m: f32,
+    }
 }
 
 pub(super) struct InputPass {
@@ -89,13 +90,6 @@ pub(super) struct InputPass {
 impl InputPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("input", crate::shaders::RENDER_SPLAT_INPUT_COMP)
-            .bindings(&[
-                BindingKind::StorageImage,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageImage,
-                BindingKind::StorageImage,
-                BindingKind::StorageImage,
-            ])
             .push_constants::<InputPush>()
             .build(ctx)?;
         Ok(InputPass { pipeline })
@@ -177,11 +171,13 @@ impl Source<'_, '_> {
             });
         }
         let staging = frame.staging.as_mut().expect("made above");
-        write_mapped_at(&mut staging.color, 0, input.color);
-        write_mapped_at(&mut staging.depth, 0, input.depth_m);
+        staging.color.write_mapped(0, input.color)?;
+        staging.depth.write_mapped(0, input.depth_m)?;
         for (k, layer) in input.hidden_layers.iter().enumerate() {
-            write_mapped_at(&mut staging.color, (k + 1) * pixels, layer.color);
-            write_mapped_at(&mut staging.depth, (k + 1) * pixels, layer.depth_m);
+            staging.color.write_mapped((k + 1) * pixels, layer.color)?;
+            staging
+                .depth
+                .write_mapped((k + 1) * pixels, layer.depth_m)?;
         }
         Ok((pixels * 20 * frame.layers as usize) as u64)
     }
@@ -206,38 +202,24 @@ impl Source<'_, '_> {
                 for layer in 0..layers {
                     let out = recorded.record_layer(rec, layer)?;
                     rec.begin_pass("input");
-                    rec.dispatch(
-                        &pass.pipeline,
-                        &[
-                            Binding::Storage(out.color),
-                            Binding::Buffer(out.depth_m),
-                            Binding::Storage(&frame.color_in),
-                            Binding::Storage(&frame.depth_in),
-                            Binding::Storage(out.previous_depth),
-                        ],
-                        &InputPush {
+                    rec.compute(&pass.pipeline)
+                        .read("raster_color", out.color)
+                        .read("RasterDepth", out.depth_m)
+                        .write("color_in", &frame.color_in)
+                        .write("depth_in", &frame.depth_in)
+                        .write("previous_depth", out.previous_depth)
+                        .push(&InputPush {
                             width: frame.width,
                             height: frame.height,
                             layer,
                             write_previous: u32::from(layer + 1 < layers),
                             near_m: crate::render::focus::nearest_supported_m(),
                             far_m: out.far_m,
-                        },
-                        [frame.width.div_ceil(8), frame.height.div_ceil(8), 1],
-                    )?;
+                        })
+                        .dispatch([frame.width.div_ceil(8), frame.height.div_ceil(8), 1])?;
                 }
                 Ok(())
             }
         }
     }
-}
-
-/// Writes `data` into a mapped buffer starting at element `offset` (elements of `T`).
-pub(super) fn write_mapped_at<T: bytemuck::Pod>(buffer: &mut Buffer, offset: usize, data: &[T]) {
-    let size = std::mem::size_of::<T>();
-    let bytes: &[u8] = bytemuck::cast_slice(data);
-    buffer
-        .mapped_bytes_mut()
-        .expect("upload buffers are host-visible")[offset * size..offset * size + bytes.len()]
-        .copy_from_slice(bytes);
 }

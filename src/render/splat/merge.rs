@@ -2,20 +2,20 @@
 //! optionally 4×4 up to 32×32): the seed paper's similar-colour rule, or level of detail by
 //! blur. See glsl/render/splat/merge.comp.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
 
-use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::{FrameBlock, FrameUniform};
+use super::Resources;
 
-/// Push constants of one merge dispatch. Mirrors `MergePush` in glsl/render/splat/merge.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct MergePush {
-    /// Side of the blocks this dispatch makes: 2, then 4, … 32.
-    pub block_size: u32,
-    /// Level of detail by blur (see [`super::MergeSettings::blur_per_block`]); 0: the seed
-    /// paper's tolerances.
-    pub blur_per_block: f32,
+shader_block! {
+    /// Push constants of one merge dispatch. Mirrors `MergePush` in glsl/render/splat/merge.comp.
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct MergePush {
+        /// Side of the blocks this dispatch makes: 2, then 4, … 32.
+        pub block_size: u32,
+        /// Level of detail by blur (see [`super::MergeSettings::blur_per_block`]); 0: the seed
+        /// paper's tolerances.
+        pub blur_per_block: f32,
+    }
 }
 
 pub(super) struct MergePass {
@@ -25,8 +25,6 @@ pub(super) struct MergePass {
 impl MergePass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("merge", crate::shaders::RENDER_SPLAT_MERGE_COMP)
-            .bindings(&kinds_with_fragments(&[BindingKind::StorageBuffer], &[]))
-            .uniform::<FrameUniform>()
             .push_constants::<MergePush>()
             .build(ctx)?;
         Ok(MergePass { pipeline })
@@ -36,28 +34,24 @@ impl MergePass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        frame: FrameBlock<'_>,
+        r: &Resources<'_>,
         (levels, blur_per_block): (u32, f32),
-        radii: &Buffer,
-        fragments: &FragmentStore,
     ) -> GpuResult<()> {
         for level in 1..=levels {
             let size = 1u32 << level;
-            let blocks = [frame.values.width / size, frame.values.height / size];
+            let blocks = [r.block.values.width / size, r.block.values.height / size];
             if blocks[0] == 0 || blocks[1] == 0 {
                 break;
             }
-            let mut bindings = fragments.bind_with(&[Binding::Buffer(radii)], &[]);
-            bindings.push(frame.binding());
-            rec.dispatch(
-                &self.pipeline,
-                &bindings,
-                &MergePush {
+            rec.compute(&self.pipeline)
+                .read("Radii", r.radii)
+                .write("Fragments", &r.frame.fragments)
+                .read("FrameUniform", r.block.buffer)
+                .push(&MergePush {
                     block_size: size,
                     blur_per_block,
-                },
-                [blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1],
-            )?;
+                })
+                .dispatch([blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1])?;
         }
         Ok(())
     }

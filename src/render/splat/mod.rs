@@ -35,7 +35,7 @@ mod uniform;
 use crate::gpu::{Buffer, Context, GpuError, Image, Residency, Sampler, Timings};
 use crate::psf::kernels::KernelGrid;
 
-use bands::{plan_bands, BandPush, PlannedBands};
+use bands::{plan_bands, BandPush, BandSlot, PlannedBands};
 pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{ConvolveWalk, MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
@@ -167,6 +167,20 @@ struct FrameResources {
     /// counts (tiles + 1, the last = live fragments), offsets (tiles + 1, the last = total),
     /// then the band table's header ([`band_header_at`]).
     readback_lists: Buffer,
+}
+
+/// What the passes of a frame bind: the frame's uniform block and per-size resources, and the
+/// splatter's tables and PSF texture. Each pass's `record` takes it whole and binds what its
+/// shader names.
+#[derive(Clone, Copy)]
+struct Resources<'a> {
+    block: FrameBlock<'a>,
+    frame: &'a FrameResources,
+    radii: &'a Buffer,
+    field_table: &'a Buffer,
+    texture: &'a Image,
+    sampler: &'a Sampler,
+    atlas: &'a Buffer,
 }
 
 pub struct Splatter {
@@ -325,9 +339,9 @@ impl Splatter {
             .collect();
         // Inputs and radii go through persistent mapped buffers: no allocation per frame.
         let input_bytes = source.stage(&ctx, self.frame.as_mut().expect("ensured above"))?;
-        input::write_mapped_at(&mut self.radii_staging, 0, &radii);
+        self.radii_staging.write_mapped(0, &radii)?;
         let table = self.field_table.contents(self.nodes(), &blend);
-        input::write_mapped_at(&mut self.field_table.staging, 0, &table);
+        self.field_table.staging.write_mapped(0, &table)?;
         let projection = crate::render::projection::Projection {
             width: w,
             height: h,
@@ -340,7 +354,9 @@ impl Splatter {
         // Through the persistent mapping: submissions complete before `submit` returns, so no
         // earlier frame still reads it.
         let frame_mut = self.frame.as_mut().expect("ensured above");
-        input::write_mapped_at(&mut frame_mut.uniform, 0, std::slice::from_ref(&params));
+        frame_mut
+            .uniform
+            .write_mapped(0, std::slice::from_ref(&params))?;
         let upload_bytes =
             input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16 + FRAME_UNIFORM_BYTES;
         let frame = self.frame.as_ref().expect("ensured above");
@@ -349,6 +365,7 @@ impl Splatter {
             values: &params,
             buffer: &frame.uniform,
         };
+        let r = self.resources(frame, block);
         let tiles = frame.tiles_x * frame.tiles_y;
         let rebuild_texture = self.texture_blend.as_ref() != Some(&blend);
         let output_bytes = pixels as u64 * 16;
@@ -370,13 +387,13 @@ impl Splatter {
             let slots = steady_slots(self.last_lists.map_or(1, |(_, bands)| bands));
             let timings = ctx.submit(|rec| {
                 let texture = rebuild_texture.then_some(&blend);
-                self.record_front(rec, &source, frame, block, texture, hidden)?;
-                self.record_back(rec, frame, block, slots, entries)?;
+                self.record_front(rec, &source, &r, texture, hidden)?;
+                self.record_back(rec, &r, slots, entries)?;
                 sync = rec.barrier_counts();
                 Ok(())
             })?;
             submissions += 1;
-            let planned = read_band_header(&frame.readback_lists, header_at);
+            let planned = read_band_header(&frame.readback_lists, header_at)?;
             if planned.complete() {
                 self.texture_blend = Some(blend);
                 self.last_lists = Some((u64::from(planned.total_entries), planned.bands));
@@ -396,7 +413,7 @@ impl Splatter {
                     readback_bytes: output_bytes + bands::BAND_TABLE_HEADER_BYTES,
                     psf_texture_bytes: self.psf_texture_bytes(),
                 };
-                let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
+                let color: Vec<[f32; 4]> = frame.readback_color.read_mapped_all()?;
                 check_every_pixel_written(&color, w as usize)?;
                 return Ok(SplatOutput {
                     color,
@@ -410,7 +427,7 @@ impl Splatter {
         // Planning frame: everything up to the exact list sizes, read back to size the list
         // buffer and count the bands; the GPU then plans the same bands (checked below).
         let mut timings = ctx.submit(|rec| {
-            self.record_front(rec, &source, frame, block, Some(&blend), hidden)?;
+            self.record_front(rec, &source, &r, Some(&blend), hidden)?;
             rec.end_pass();
             rec.copy_buffer_region(
                 &frame.counts,
@@ -431,7 +448,7 @@ impl Splatter {
             Ok(())
         })?;
         submissions += 1;
-        let sizes: Vec<u32> = read_mapped(&frame.readback_lists);
+        let sizes: Vec<u32> = frame.readback_lists.read_mapped_all()?;
         let counts = sizes[..tiles as usize].to_vec();
         let live = u64::from(sizes[tiles as usize]);
         let offsets = sizes[tiles as usize + 1..2 * (tiles as usize + 1)].to_vec();
@@ -457,19 +474,20 @@ impl Splatter {
             values: &params,
             buffer: &frame.uniform,
         };
+        let r = self.resources(frame, block);
         let entries = self.entries.as_ref().expect("ensured above");
         // The bands of the buffer actually made (it may hold more than the largest band, never
         // less): the plan every later steady frame repeats on the GPU.
         let bands = plan_bands(&counts, frame.tiles_x, u64::from(entries_in(entries)))?;
         let slots = bands.len() as u32;
         let band_timings = ctx.submit(|rec| {
-            self.record_back(rec, frame, block, slots, entries)?;
+            self.record_back(rec, &r, slots, entries)?;
             let (b, c) = rec.barrier_counts();
             sync = (sync.0 + b, sync.1 + c);
             Ok(())
         })?;
         submissions += 1;
-        let planned = read_band_header(&frame.readback_lists, header_at);
+        let planned = read_band_header(&frame.readback_lists, header_at)?;
         if !planned.complete() || planned.bands != slots {
             return Err(GpuError::Usage {
                 pass: "band plan".into(),
@@ -483,7 +501,7 @@ impl Splatter {
         timings.extend(band_timings);
         self.texture_blend = Some(blend);
         self.last_lists = Some((total, slots));
-        let color: Vec<[f32; 4]> = read_mapped(&frame.readback_color);
+        let color: Vec<[f32; 4]> = frame.readback_color.read_mapped_all()?;
         check_every_pixel_written(&color, w as usize)?;
         let stats = SplatStats {
             fragments: pixels as u64,
@@ -542,17 +560,30 @@ impl Splatter {
         }
     }
 
+    /// What the passes of `frame` bind.
+    fn resources<'a>(&'a self, frame: &'a FrameResources, block: FrameBlock<'a>) -> Resources<'a> {
+        Resources {
+            block,
+            frame,
+            radii: &self.radii,
+            field_table: &self.field_table.buffer,
+            texture: &self.texture,
+            sampler: &self.sampler,
+            atlas: &self.atlas,
+        }
+    }
+
     /// Records the passes before the lists: inputs, PSF texture (given the blend when it
     /// changed), fragments, merging, tile counts and their prefix sum.
     fn record_front(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
         source: &input::Source<'_, '_>,
-        frame: &FrameResources,
-        block: FrameBlock<'_>,
+        r: &Resources<'_>,
         rebuild_texture: Option<&crate::psf::kernels::GridBlend>,
         hidden: fragments::HiddenLight,
     ) -> crate::gpu::GpuResult<()> {
+        let frame = r.frame;
         source.record(rec, &self.input, frame)?;
         rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
         rec.copy_buffer(
@@ -570,58 +601,25 @@ impl Splatter {
                 rec.clear_image(&self.texture, [0.0; 4]);
             }
             let blocks: Vec<field::BlockKernels> = self.layout.blocks.iter().map(|b| b.0).collect();
-            for (node, resident) in self.resident.iter().enumerate() {
-                self.psf_texture.record(
-                    rec,
-                    block,
-                    resident,
-                    blend,
-                    node as u32,
-                    &self.texture,
-                    &self.atlas,
-                    &blocks,
-                )?;
-            }
+            self.psf_texture
+                .record(rec, r, &self.resident, blend, &blocks)?;
         }
         rec.begin_pass("fragments");
-        self.fragments_pass.record(
-            rec,
-            block,
-            &frame.color_in,
-            &frame.depth_in,
-            &self.radii,
-            &self.field_table.buffer,
-            &frame.fragments,
-            hidden,
-        )?;
-        if self.settings.merge.levels > 0 {
+        self.fragments_pass.record(rec, r, hidden)?;
+        let merge = &self.settings.merge;
+        if merge.levels > 0 {
             rec.begin_pass("merge");
-            self.merge.record(
-                rec,
-                block,
-                (
-                    self.settings.merge.levels,
-                    self.settings.merge.blur_per_block,
-                ),
-                &self.radii,
-                &frame.fragments,
-            )?;
+            self.merge
+                .record(rec, r, (merge.levels, merge.blur_per_block))?;
         }
         rec.begin_pass("tile count");
         // Alpha 0 marks a pixel the convolution has not written (it writes alpha 1 to every
         // pixel of its tiles): the host checks the frame it reads back.
         rec.clear_image(&frame.color_out, [0.0; 4]);
         rec.fill_buffer(&frame.counts, 0);
-        self.tile_count
-            .record(rec, block, &frame.fragments, &frame.counts)?;
+        self.tile_count.record(rec, r)?;
         rec.begin_pass("prefix sum");
-        self.prefix_sum.record(
-            rec,
-            frame.tiles_x * frame.tiles_y,
-            &frame.counts,
-            &frame.offsets,
-            &frame.block_sums,
-        )?;
+        self.prefix_sum.record(rec, r)?;
         Ok(())
     }
 
@@ -630,65 +628,29 @@ impl Splatter {
     fn record_back(
         &self,
         rec: &mut crate::gpu::Recorder<'_>,
-        frame: &FrameResources,
-        block: FrameBlock<'_>,
+        r: &Resources<'_>,
         slots: u32,
         entries: &Buffer,
     ) -> crate::gpu::GpuResult<()> {
+        let frame = r.frame;
         let entry_capacity = entries_in(entries);
         rec.begin_pass("band plan");
-        self.band_plan.record(
-            rec,
-            &band_plan::BandPlanPush {
-                tiles_x: frame.tiles_x,
-                tiles: frame.tiles_x * frame.tiles_y,
-                capacity: entry_capacity,
-                slots,
-            },
-            &frame.counts,
-            &frame.offsets,
-            &frame.band_table,
-        )?;
+        self.band_plan.record(rec, r, (slots, entry_capacity))?;
         for slot in 0..slots {
-            let band = BandPush {
-                slot,
-                entry_capacity,
+            let band = BandSlot {
+                push: BandPush {
+                    slot,
+                    entry_capacity,
+                },
+                entries,
             };
             rec.begin_pass("tile fill");
             rec.fill_buffer(&frame.cursors, 0);
-            self.tile_fill.record(
-                rec,
-                block,
-                &band,
-                &frame.band_table,
-                &frame.fragments,
-                &frame.offsets,
-                &frame.cursors,
-                entries,
-            )?;
+            self.tile_fill.record(rec, r, &band)?;
             rec.begin_pass("tile sort");
-            self.tile_sort.record(
-                rec,
-                &band,
-                &frame.band_table,
-                &frame.counts,
-                &frame.offsets,
-                entries,
-            )?;
+            self.tile_sort.record(rec, r, &band)?;
             rec.begin_pass("convolve");
-            self.convolve.record(
-                rec,
-                block,
-                &band,
-                &frame.band_table,
-                (&self.texture, &self.sampler, &self.atlas),
-                &self.field_table.buffer,
-                &frame.fragments,
-                &frame.counts,
-                &frame.offsets,
-                entries,
-                &frame.color_out,
-            )?;
+            self.convolve.record(rec, r, &band)?;
         }
         rec.copy_buffer_region(
             &frame.band_table,
@@ -732,14 +694,10 @@ impl Splatter {
 }
 
 /// The band table's header from the list-sizes read-back.
-fn read_band_header(readback: &Buffer, at: u64) -> PlannedBands {
-    let bytes = readback
-        .mapped_bytes()
-        .expect("read-back buffers are host-visible");
-    let at = at as usize;
-    let words: Vec<u32> =
-        bytemuck::pod_collect_to_vec(&bytes[at..at + bands::BAND_TABLE_HEADER_BYTES as usize]);
-    PlannedBands::from_header(&words)
+fn read_band_header(readback: &Buffer, at: u64) -> crate::gpu::GpuResult<PlannedBands> {
+    let words = readback
+        .read_mapped::<u32>(at as usize / 4, bands::BAND_TABLE_HEADER_BYTES as usize / 4)?;
+    Ok(PlannedBands::from_header(&words))
 }
 
 /// Entries a list buffer holds.
@@ -762,15 +720,6 @@ fn check_every_pixel_written(color: &[[f32; 4]], width: usize) -> crate::gpu::Gp
         x: first % width.max(1),
         y: first / width.max(1),
     })
-}
-
-/// The contents of a host-visible read-back buffer.
-fn read_mapped<T: bytemuck::Pod>(buffer: &Buffer) -> Vec<T> {
-    let bytes = buffer
-        .mapped_bytes()
-        .expect("read-back buffers are host-visible");
-    let n = bytes.len() / std::mem::size_of::<T>();
-    bytemuck::pod_collect_to_vec(&bytes[..n * std::mem::size_of::<T>()])
 }
 
 /// Sums the timings of passes that ran once per band, keeping first-seen order.

@@ -2,39 +2,40 @@
 //! into the 3D texture the convolution samples. See glsl/render/splat/psf_texture.comp.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage, Recorder,
-    TexelFormat,
+    shader_block, Binding, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage,
+    Recorder, TexelFormat,
 };
 use crate::psf::kernels::{
     level_block_radius, level_count, texels_below_level, GridBlend, KernelGrid, KernelSet,
 };
 
 use super::field::BlockKernels;
-use super::{FrameBlock, FrameUniform};
+use super::Resources;
 
-/// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node, its
-/// plain kernels or one block side's). Mirrors `PsfTexturePush` in
-/// glsl/render/splat/psf_texture.comp (std430: the vec4 sits at offset 16, right after the
-/// four uints).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(super) struct PsfTexturePush {
-    /// The chunk's radius levels [first_level, end_level).
-    pub first_level: u32,
-    pub end_level: u32,
-    /// Index of the chunk's first texel in a whole kernel set.
-    pub first_texel: u32,
-    /// The field node (h-major; on axis 0) whose region of the atlas is written
-    /// (`field::TextureLayout`).
-    pub node: u32,
-    /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
-    pub corner_weights: [f32; 4],
-    /// 0: the plain kernels; 4, 8, 16 or 32: the kernels summed over blocks of that side.
-    pub block_side: u32,
-    /// To the block's 48 bytes (std430 rounds it to the vec4's alignment).
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
+shader_block! {
+    /// Push constants of one PSF-texture dispatch (a chunk of radius levels of one field node, its
+    /// plain kernels or one block side's). Mirrors `PsfTexturePush` in
+    /// glsl/render/splat/psf_texture.comp (std430: the vec4 sits at offset 16, right after the
+    /// four uints).
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct PsfTexturePush {
+        /// The chunk's radius levels [first_level, end_level).
+        pub first_level: u32,
+        pub end_level: u32,
+        /// Index of the chunk's first texel in a whole kernel set.
+        pub first_texel: u32,
+        /// The field node (h-major; on axis 0) whose region of the atlas is written
+        /// (`field::TextureLayout`).
+        pub node: u32,
+        /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
+        pub corner_weights: [f32; 4],
+        /// 0: the plain kernels; 4, 8, 16 or 32: the kernels summed over blocks of that side.
+        pub block_side: u32,
+        /// To the block's 48 bytes (std430 rounds it to the vec4's alignment).
+        pub pad0: u32,
+        pub pad1: u32,
+        pub pad2: u32,
+    }
 }
 
 /// Texel format of the PSF texture: half floats halve memory and bandwidth; kernels are
@@ -179,34 +180,35 @@ impl PsfTexturePass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("psf texture", crate::shaders::RENDER_SPLAT_PSF_TEXTURE_COMP)
-                .bindings(&[
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageImage,
-                    BindingKind::StorageBuffer,
-                ])
-                .uniform::<FrameUniform>()
                 .push_constants::<PsfTexturePush>()
                 .build(ctx)?;
         Ok(PsfTexturePass { pipeline })
     }
 
-    /// Writes field node `node`'s kernels for `blend` into its region of `texture`, whose
-    /// layout `atlas` holds (glsl/common/atlas.glsl): the plain kernels, then per block side
-    /// of `blocks` its block-summed ones (a block's texels read the chunk's kernel sets, so
-    /// each chunk writes its own levels of every kind).
-    #[allow(clippy::too_many_arguments)]
+    /// Writes each field node's kernels for `blend` into its region of the PSF texture, whose
+    /// layout the atlas holds (glsl/common/atlas.glsl): per node of `nodes` (on axis one), the
+    /// plain kernels, then per block side of `blocks` its block-summed ones (a block's texels
+    /// read the chunk's kernel sets, so each chunk writes its own levels of every kind).
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        frame: FrameBlock<'_>,
-        grid: &ResidentGrid,
+        r: &Resources<'_>,
+        nodes: &[ResidentGrid],
         blend: &GridBlend,
-        node: u32,
-        texture: &Image,
-        atlas: &Buffer,
+        blocks: &[BlockKernels],
+    ) -> GpuResult<()> {
+        for (node, grid) in nodes.iter().enumerate() {
+            self.record_node(rec, r, (node as u32, grid), blend, blocks)?;
+        }
+        Ok(())
+    }
+
+    fn record_node(
+        &self,
+        rec: &mut Recorder<'_>,
+        r: &Resources<'_>,
+        (node, grid): (u32, &ResidentGrid),
+        blend: &GridBlend,
         blocks: &[BlockKernels],
     ) -> GpuResult<()> {
         let chunks = grid.sets[blend.corners[0].0].len();
@@ -216,7 +218,7 @@ impl PsfTexturePass {
                 |k: usize| &grid.sets[blend.corners.get(k).unwrap_or(&blend.corners[0]).0][chunk];
             let weight = |k: usize| blend.corners.get(k).map_or(0.0, |c| c.1 as f32);
             let first = corner(0);
-            let layers = (first.end_level - first.first_level) * frame.values.object_count;
+            let layers = (first.end_level - first.first_level) * r.block.values.object_count;
             let largest = level_block_radius(first.end_level - 1);
             // Plain kernels (side 0), then each block side whose levels this chunk holds; each
             // dispatch covers the chunk's largest slot with its ring of zeros.
@@ -238,20 +240,16 @@ impl PsfTexturePass {
                     pad1: 0,
                     pad2: 0,
                 };
-                rec.dispatch(
-                    &self.pipeline,
-                    &[
-                        Binding::Buffer(&corner(0).buffer),
-                        Binding::Buffer(&corner(1).buffer),
-                        Binding::Buffer(&corner(2).buffer),
-                        Binding::Buffer(&corner(3).buffer),
-                        Binding::Storage(texture),
-                        Binding::Buffer(atlas),
-                        frame.binding(),
-                    ],
-                    &push,
-                    [side.div_ceil(8), side.div_ceil(8), layers],
-                )?;
+                rec.compute(&self.pipeline)
+                    .read(
+                        "Set",
+                        [0, 1, 2, 3].map(|k| Binding::Buffer(&corner(k).buffer)),
+                    )
+                    .write("psf_texture", r.texture)
+                    .read("Atlas", r.atlas)
+                    .read("FrameUniform", r.block.buffer)
+                    .push(&push)
+                    .dispatch([side.div_ceil(8), side.div_ceil(8), layers])?;
             }
         }
         Ok(())

@@ -1,10 +1,9 @@
 //! Tile-count pass: how many fragments each screen tile's list will hold (exact overlap of the
 //! kernel's square support with the tile). See glsl/render/splat/tile_count.comp.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
 
-use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::{FrameBlock, FrameUniform};
+use super::Resources;
 
 pub(super) struct TileCountPass {
     pipeline: ComputePipeline,
@@ -14,28 +13,18 @@ impl TileCountPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
-                .bindings(&kinds_with_fragments(&[], &[BindingKind::StorageBuffer]))
-                .uniform::<FrameUniform>()
                 .build(ctx)?;
         Ok(TileCountPass { pipeline })
     }
 
-    /// `counts` must be zeroed (tiles + 1 elements; the last counts live fragments).
-    pub fn record(
-        &self,
-        rec: &mut Recorder<'_>,
-        frame: FrameBlock<'_>,
-        fragments: &FragmentStore,
-        counts: &Buffer,
-    ) -> GpuResult<()> {
-        let mut bindings = fragments.bind_with(&[], &[Binding::Buffer(counts)]);
-        bindings.push(frame.binding());
-        let p = frame.values;
-        rec.dispatch(
-            &self.pipeline,
-            &bindings,
-            &(),
-            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
-        )
+    /// `r.frame.counts` must be zeroed (tiles + 3 elements: the live fragments and the kernel
+    /// evaluations follow the tiles).
+    pub fn record(&self, rec: &mut Recorder<'_>, r: &Resources<'_>) -> GpuResult<()> {
+        let p = r.block.values;
+        rec.compute(&self.pipeline)
+            .read("Fragments", &r.frame.fragments)
+            .write("Counts", &r.frame.counts)
+            .read("FrameUniform", r.block.buffer)
+            .dispatch([p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1])
     }
 }

@@ -1,11 +1,10 @@
 //! Tile-fill pass: writes each fragment's (depth, index) key into the list of every tile of
 //! the current band it reaches. See glsl/render/splat/tile_fill.comp.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
 
-use super::bands::BandPush;
-use super::fragments::{kinds_with_fragments, FragmentStore};
-use super::{FrameBlock, FrameUniform};
+use super::bands::{BandPush, BandSlot};
+use super::Resources;
 
 pub(super) struct TileFillPass {
     pipeline: ComputePipeline,
@@ -15,51 +14,28 @@ impl TileFillPass {
     pub fn new(ctx: &Context) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("tile fill", crate::shaders::RENDER_SPLAT_TILE_FILL_COMP)
-                .bindings(&kinds_with_fragments(
-                    &[],
-                    &[
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                        BindingKind::StorageBuffer,
-                    ],
-                ))
-                .uniform::<FrameUniform>()
                 .push_constants::<BandPush>()
                 .build(ctx)?;
         Ok(TileFillPass { pipeline })
     }
 
-    /// `cursors` must be zeroed; `entries` holds the lists of the band in `band.slot` of
-    /// `bands` (the band table).
-    #[allow(clippy::too_many_arguments)]
+    /// `r.frame.cursors` must be zeroed; `band.entries` receives the lists of the band in
+    /// `band.push.slot` of the band table.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        frame: FrameBlock<'_>,
-        band: &BandPush,
-        bands: &Buffer,
-        fragments: &FragmentStore,
-        offsets: &Buffer,
-        cursors: &Buffer,
-        entries: &Buffer,
+        r: &Resources<'_>,
+        band: &BandSlot<'_>,
     ) -> GpuResult<()> {
-        let mut bindings = fragments.bind_with(
-            &[],
-            &[
-                Binding::Buffer(offsets),
-                Binding::Buffer(cursors),
-                Binding::Buffer(entries),
-                Binding::Buffer(bands),
-            ],
-        );
-        bindings.push(frame.binding());
-        let p = frame.values;
-        rec.dispatch(
-            &self.pipeline,
-            &bindings,
-            band,
-            [p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1],
-        )
+        let p = r.block.values;
+        rec.compute(&self.pipeline)
+            .read("Fragments", &r.frame.fragments)
+            .read("Offsets", &r.frame.offsets)
+            .write("Cursors", &r.frame.cursors)
+            .write("Entries", band.entries)
+            .read("BandTable", &r.frame.band_table)
+            .read("FrameUniform", r.block.buffer)
+            .push(&band.push)
+            .dispatch([p.width.div_ceil(8), (p.height * p.layers).div_ceil(8), 1])
     }
 }

@@ -1,9 +1,10 @@
 //! Tile-sort pass: sorts each tile's list by (depth, fragment index), one workgroup per tile.
 //! See glsl/render/splat/tile_sort.comp.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
 
-use super::bands::{dispatch_offset, BandPush};
+use super::bands::{dispatch_offset, BandPush, BandSlot};
+use super::Resources;
 
 pub(super) struct TileSortPass {
     pipeline: ComputePipeline,
@@ -14,12 +15,6 @@ impl TileSortPass {
         let cpu = ctx.device_info().kind == crate::gpu::DeviceKind::Cpu;
         let pipeline =
             ComputePipeline::builder("tile sort", crate::shaders::RENDER_SPLAT_TILE_SORT_COMP)
-                .bindings(&[
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                    BindingKind::StorageBuffer,
-                ])
                 .push_constants::<BandPush>()
                 // keys each thread ranks (glsl/render/splat/tile_sort.comp)
                 .specialize(0, if cpu { 8 } else { 2 })
@@ -27,28 +22,21 @@ impl TileSortPass {
         Ok(TileSortPass { pipeline })
     }
 
-    /// One workgroup per tile of the band in `band.slot` of `bands`, dispatched as the band
-    /// table says.
+    /// One workgroup per tile of the band in `band.push.slot` of the band table, dispatched
+    /// as the table says.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
-        band: &BandPush,
-        bands: &Buffer,
-        counts: &Buffer,
-        offsets: &Buffer,
-        entries: &Buffer,
+        r: &Resources<'_>,
+        band: &BandSlot<'_>,
     ) -> GpuResult<()> {
-        rec.dispatch_indirect(
-            &self.pipeline,
-            &[
-                Binding::Buffer(counts),
-                Binding::Buffer(offsets),
-                Binding::Buffer(entries),
-                Binding::Buffer(bands),
-            ],
-            band,
-            bands,
-            dispatch_offset(band.slot),
-        )
+        let table = &r.frame.band_table;
+        rec.compute(&self.pipeline)
+            .read("Counts", &r.frame.counts)
+            .read("Offsets", &r.frame.offsets)
+            .write("Entries", band.entries)
+            .read("BandTable", table)
+            .push(&band.push)
+            .dispatch_indirect(table, dispatch_offset(band.push.slot))
     }
 }

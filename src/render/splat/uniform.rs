@@ -1,7 +1,7 @@
 //! The frame's uniform block: values every pass and every dispatch of a splat frame shares
 //! (glsl/common/splat.glsl), as opposed to each pass's own push constants.
 
-use crate::gpu::{Binding, Buffer};
+use crate::gpu::Buffer;
 use crate::render::blend::BlendMode;
 
 use super::{FrameResources, Splatter};
@@ -9,8 +9,8 @@ use super::{FrameResources, Splatter};
 /// Mirrors the uniform block `FrameUniform` in glsl/common/splat.glsl: what every pass and
 /// every dispatch of a frame shares, written once per frame through a persistent mapping
 /// (values that change between dispatches are each pass's own push constants). std140 lays
-/// out scalars as `repr(C)` does; the block's size is checked against each shader when its
-/// pipeline is built, and its members' names and offsets by a test.
+/// out scalars as `repr(C)` does; a buffer bound to the block must hold its size, and its
+/// members' names and offsets are checked by a test (`block_layouts`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct FrameUniform {
@@ -42,17 +42,11 @@ pub(crate) struct FrameUniform {
 pub const FRAME_UNIFORM_BYTES: u64 = std::mem::size_of::<FrameUniform>() as u64;
 
 /// A frame's uniform values (for dispatch sizes on the host) and the buffer the shaders read
-/// them from (every pass's last binding).
+/// them from (the block `FrameUniform`).
 #[derive(Clone, Copy)]
 pub(super) struct FrameBlock<'a> {
     pub values: &'a FrameUniform,
     pub buffer: &'a Buffer,
-}
-
-impl<'a> FrameBlock<'a> {
-    pub fn binding(&self) -> Binding<'a> {
-        Binding::Buffer(self.buffer)
-    }
 }
 
 impl Splatter {
