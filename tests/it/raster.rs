@@ -1,7 +1,7 @@
 //! The rasteriser on lavapipe: metric depth, angular size, shading calibration, the shipped
 //! scenes, and the graphics-pipeline layer's own checks.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -2,7 +2,7 @@
 //! the geometric blur disc of pure defocus, the centroid of an aberrated point (a theorem: the
 //! centroid of any PSF is the mean ray aberration, diffraction or not), and its convergence.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

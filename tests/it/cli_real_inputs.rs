@@ -1,7 +1,7 @@
 //! `ocular render` on files shaped like Blender's (issue 19's eight defects, issue 20's
 //! non-finite colour and exposure), end to end on lavapipe with 16×16 frames.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};

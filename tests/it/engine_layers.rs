@@ -5,7 +5,7 @@
 //! host, the previous depth uploaded for the next peel, the frames uploaded to splat), and a
 //! steady frame must be one submission with no allocation and no pixel uploaded.
 
-mod common;
+use crate::common;
 
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};

@@ -1,7 +1,7 @@
 //! The GPU layer on a real Vulkan implementation (lavapipe in CI): buffers, images, the
 //! pipeline builder, timings, error reporting and validation capture.
 
-mod common;
+use crate::common;
 
 use half::f16;
 use ocular::gpu::texture_probe::TextureProbe;

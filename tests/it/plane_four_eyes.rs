@@ -5,7 +5,7 @@
 //! not the method). The figures are the plane table of docs/validation.md:
 //! `cargo test --release --test plane_four_eyes -- --nocapture`.
 
-mod common;
+use crate::common;
 
 use ocular::eye::file::resolve;
 use ocular::psf::axes::Screen;

@@ -4,7 +4,7 @@
 //! per-eye bars set just under the measured values (SSIM ≥ 0.998). The field is narrow (3°) so
 //! that the blur reaches 10–30 px on a small frame.
 
-mod common;
+use crate::common;
 
 use ocular::eye::file::resolve;
 use ocular::metrics::{psnr, ssim, ImageView};

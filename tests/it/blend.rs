@@ -4,7 +4,7 @@
 //! a negative control (the seed paper's blend, view-axis vergence, no depth groups) that must
 //! fail the same bar.
 
-mod common;
+use crate::common;
 
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::psf::kernels::{

@@ -4,7 +4,7 @@
 //! outgrow the buffer falls back to host-planned bands with the same image; the PSF texture is rebuilt only when the
 //! eye's state changes; the convolution's early exit changes the image by less than its ε.
 
-mod common;
+use crate::common;
 
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};

@@ -7,7 +7,7 @@
 //! holds the figures and what each truth shares with splat.
 //! Figures: `cargo test --release --test fidelity -- --nocapture`.
 
-mod common;
+use crate::common;
 
 use ocular::eye::file::resolve;
 use ocular::metrics::{psnr, ImageView};

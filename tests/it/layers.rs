@@ -3,7 +3,7 @@
 //! two layers and not with one; a hidden layer that is empty changes nothing; what a floor
 //! buries stays hidden.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

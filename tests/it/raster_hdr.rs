@@ -1,7 +1,7 @@
 //! HDR without a ceiling (issue 20, defect 7): the rasteriser's colour targets were half float,
 //! which clipped every value above 65504 cd/m² (a lamp, the sun) without a word.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

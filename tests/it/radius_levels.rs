@@ -3,7 +3,7 @@
 //! at least half a pixel (quarter-pixel levels below 2 px); whole-pixel levels everywhere (the
 //! old layout, the negative control) do not.
 
-mod common;
+use crate::common;
 
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{kernel_side, level_block_radius, level_of_radius, level_radius_px};

@@ -3,7 +3,7 @@
 //! Every file's colour and depth planes carry distinct values, so that taking the wrong plane
 //! fails the assertions instead of passing by coincidence.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

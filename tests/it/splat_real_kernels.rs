@@ -3,7 +3,7 @@
 //! eye. Depths sit between the grid's object samples, so interpolation over distance and
 //! radius is exercised.
 
-mod common;
+use crate::common;
 
 use ocular::eye::Eye;
 use ocular::psf::axes::{GridAxes, KernelSettings, Screen};

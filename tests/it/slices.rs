@@ -1,7 +1,7 @@
 //! The depth-slice baseline against the ground truth and the splat runtime on a layered scene:
 //! it handles occlusion only at slice boundaries, so it must be clearly worse than splatting.
 
-mod common;
+use crate::common;
 
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::metrics::{psnr, ssim, ImageView};

@@ -2,7 +2,7 @@
 //! the CPU blend of the kernel grid, each pass against a CPU implementation of its step, and
 //! whole frames against the ground-truth renderer.
 
-mod common;
+use crate::common;
 
 use common::splat_cpu;
 use common::synthetic::{ExactSynthetic, SyntheticEye};

@@ -7,7 +7,7 @@
 //! 1280×720 frame's (a coarser sampling of the same surfaces can miss a near point, never
 //! invent one). The CLI level renders and exports each scene at 64×36 and 160×90.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 use std::process::{Command, Stdio};

@@ -6,7 +6,7 @@
 //! with splat, not the lattice). Figures:
 //! `cargo test --release --test off_axis_runtime -- --nocapture`.
 
-mod common;
+use crate::common;
 
 use ocular::eye::file::resolve;
 use ocular::psf::axes::Screen;

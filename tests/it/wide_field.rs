@@ -4,7 +4,7 @@
 //! geometry; the seed paper's geometry (view-axis vergence, the centre's scale) is the negative
 //! control.
 
-mod common;
+use crate::common;
 
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::psf::kernels::DioptreAxis;

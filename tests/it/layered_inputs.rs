@@ -1,7 +1,7 @@
 //! Layered EXR input (parts layer0, layer1, … with R, G, B, Z) and the command-line checks of
 //! the partial-occlusion options (--views, --layers, --truth views).
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
