@@ -1,5 +1,6 @@
 //! Zernike set files (TOML, CSV, ABP) and the built-in presets.
 
+use crate::common::temp_dir;
 use ocular::aberrations::*;
 use ocular::optics::zernike::Prescription;
 
@@ -196,8 +197,7 @@ fn inline_comments_and_blank_lines_are_ignored() {
 
 #[test]
 fn load_from_files_by_extension() {
-    let dir = std::env::temp_dir().join(format!("ocular-ab-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("files");
     let p = dir.join("eye.abp");
     std::fs::write(&p, "Ap = 5\nWa = 587.56\nZ[2,  0] =  5.4127").unwrap();
     let s = ZernikeSet::load(&p, None, None).unwrap();

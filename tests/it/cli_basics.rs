@@ -1,10 +1,6 @@
 //! The binary end to end: version, device listing, and a clear exit-2 error for a bad device.
 
-use std::process::Command;
-
-fn ocular() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-}
+use crate::common::ocular;
 
 #[test]
 fn version_prints_the_crate_version() {
@@ -75,7 +71,7 @@ fn nonexistent_device_fails_with_exit_code_2_and_one_line() {
 #[test]
 fn age_outside_the_pupil_formula_is_refused() {
     for bad in ["-5", "0", "300", "inf", "nan", "abc"] {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_ocular"))
+        let out = ocular()
             .args(["render", "--age", bad, "-o", "/nonexistent/x.png"])
             .output()
             .unwrap();

@@ -2,32 +2,7 @@
 //! prescription → eye → prescription loop through `eye estimate`, `eye refract` and
 //! `eye measure --correct`, and `render --json` reporting a clamped focus (lavapipe, 160×90).
 
-use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
-
-fn ocular(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .stdin(Stdio::null())
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-corr-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn json_ok(o: &Output) -> serde_json::Value {
-    assert!(
-        o.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
-}
+use crate::common::{json_ok, ocular_run, temp_dir};
 
 #[test]
 fn every_new_option_is_range_checked_at_the_parser() {
@@ -57,7 +32,7 @@ fn every_new_option_is_range_checked_at_the_parser() {
         ] {
             let mut args = cmd.to_vec();
             args.extend_from_slice(extra);
-            let o = ocular(&args);
+            let o = ocular_run(&args);
             let text = String::from_utf8_lossy(&o.stderr);
             assert_eq!(o.status.code(), Some(2), "{args:?}: {text}");
             let first = text.lines().next().unwrap_or("");
@@ -73,7 +48,7 @@ fn every_new_option_is_range_checked_at_the_parser() {
         ["--vertex-mm", "17"],
         ["--wavelength-nm", "1001"],
     ] {
-        let o = ocular(&["eye", "refract", "myopia", bad[0], bad[1]]);
+        let o = ocular_run(&["eye", "refract", "myopia", bad[0], bad[1]]);
         let text = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{text}");
         assert!(text.lines().next().unwrap().contains(bad[0]), "{text}");
@@ -87,7 +62,7 @@ fn prescription_to_eye_to_prescription_closes() {
     let eye = eye.to_str().unwrap();
     // The prescription is a spectacle at the default 12 mm vertex distance (issue 29).
     let (s, c, a) = (-2.5, -1.25, 30.0);
-    let o = ocular(&[
+    let o = ocular_run(&[
         "eye",
         "estimate",
         "--rx",
@@ -103,7 +78,7 @@ fn prescription_to_eye_to_prescription_closes() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for vertex in ["0", "12"] {
-        let r = json_ok(&ocular(&[
+        let r = json_ok(&ocular_run(&[
             "eye",
             "refract",
             eye,
@@ -137,7 +112,7 @@ fn prescription_to_eye_to_prescription_closes() {
         assert!((got_a - a).abs() < 1.0, "vertex {vertex}: axis {got_a}");
         // The printed form goes straight back in as --correct and corrects the eye.
         let rx = r["rx"].as_str().unwrap();
-        let m = json_ok(&ocular(&[
+        let m = json_ok(&ocular_run(&[
             "eye",
             "measure",
             eye,
@@ -157,7 +132,7 @@ fn prescription_to_eye_to_prescription_closes() {
         }
         // Negative control: the same lens at the other vertex distance leaves an error.
         let other = if vertex == "0" { "12" } else { "0" };
-        let m = json_ok(&ocular(&[
+        let m = json_ok(&ocular_run(&[
             "eye",
             "measure",
             eye,
@@ -199,7 +174,7 @@ fn render_reports_the_near_point_and_reading_glasses_move_it() {
             out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
-        json_ok(&ocular(&args))
+        json_ok(&ocular_run(&args))
     };
     let old = render(&["--age", "60"]);
     assert_eq!(old["focus_d"].as_f64().unwrap(), 2.5);
@@ -225,7 +200,7 @@ fn render_reports_the_near_point_and_reading_glasses_move_it() {
 #[test]
 fn the_myopic_eye_focuses_far_only_through_its_prescription() {
     let dir = temp_dir("myopia");
-    let rx = ocular(&["eye", "refract", "myopia"]);
+    let rx = ocular_run(&["eye", "refract", "myopia"]);
     let rx = String::from_utf8_lossy(&rx.stdout)
         .lines()
         .next()
@@ -251,7 +226,7 @@ fn the_myopic_eye_focuses_far_only_through_its_prescription() {
             out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
-        json_ok(&ocular(&args))
+        json_ok(&ocular_run(&args))
     };
     let bare = render(&[]);
     assert_eq!(bare["focus_limit"], "far_point");
@@ -285,7 +260,7 @@ fn the_rendered_card_keeps_its_letters_at_twenty_and_loses_them_at_sixty() {
     let dir = temp_dir("card");
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/recipes/chart_card.toml");
     let sharp = dir.join("sharp.exr");
-    let o = ocular(&[
+    let o = ocular_run(&[
         "raster",
         "--scene",
         scene,
@@ -315,7 +290,7 @@ fn the_rendered_card_keeps_its_letters_at_twenty_and_loses_them_at_sixty() {
             out.to_str().unwrap(),
         ];
         args.extend_from_slice(extra);
-        let o = ocular(&args);
+        let o = ocular_run(&args);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         card_contrast(&out) / reference
     };

@@ -1,52 +1,25 @@
 //! `ocular eye …` end to end: estimation from a prescription (eye file, JSON, plot), an
 //! interrupted run, presets, measurement JSON, drawing, and bad input refused with exit 2.
 
+use crate::common::{self, ocular, ocular_run, ok, temp_dir};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-fn ocular(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocular-cli-eye-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// Exit code 2, one line on stderr that contains `word`.
+/// Exit code 2, one line on stderr that starts `error:` and contains `word`.
 fn refused(out: &Output, word: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(
-        err.starts_with("error:") && err.contains(word),
-        "expected {word:?} in {err}"
-    );
+    let err = common::refused(out, &[word]);
+    assert!(err.starts_with("error:"), "expected {word:?} in {err}");
 }
 
 #[test]
 fn estimate_from_prescription_writes_eye_json_and_plot() {
-    let d = scratch("rx");
+    let d = temp_dir("rx");
     let eye = d.join("eye.toml");
     let json = d.join("report.json");
     let svg = d.join("fit.svg");
     let png = d.join("fit.png");
     let s = |p: &PathBuf| p.to_str().unwrap().to_string();
-    let out = ocular(&[
+    let out = ocular_run(&[
         "eye",
         "estimate",
         "--rx",
@@ -72,9 +45,9 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
     assert!(j["eye"]["axial_length_mm"].as_f64().unwrap() > 20.0);
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
     // The file is an eye like any other.
-    let shown = ok(&ocular(&["eye", "show", &s(&eye)]));
+    let shown = ok(&ocular_run(&["eye", "show", &s(&eye)]));
     assert!(shown.contains("estimated from a 4 mm"), "{shown}");
-    let m: serde_json::Value = serde_json::from_str(&ok(&ocular(&[
+    let m: serde_json::Value = serde_json::from_str(&ok(&ocular_run(&[
         "eye",
         "measure",
         &s(&eye),
@@ -89,7 +62,7 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
     // meridians −3 and −4 D reach the entrance pupil as P/(1 − dP), d = 12 mm + the pupil's
     // depth (which `eye refract` reports).
     let r: serde_json::Value =
-        serde_json::from_str(&ok(&ocular(&["eye", "refract", &s(&eye), "--json"]))).unwrap();
+        serde_json::from_str(&ok(&ocular_run(&["eye", "refract", &s(&eye), "--json"]))).unwrap();
     let d = (12.0 + r["eye_entrance_pupil_z_mm"].as_f64().unwrap()) * 1e-3;
     let at_pupil = |p: f64| p / (1.0 - d * p);
     let expected = 0.5 * (at_pupil(-3.0) + at_pupil(-4.0));
@@ -99,7 +72,7 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
         "M = {mm}, expected {expected}"
     );
     // PNG plot of the same run.
-    ok(&ocular(&[
+    ok(&ocular_run(&[
         "eye",
         "estimate",
         "--rx",
@@ -117,9 +90,9 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
 
 #[test]
 fn time_limit_writes_best_eye_marked_not_converged() {
-    let d = scratch("limit");
+    let d = temp_dir("limit");
     let eye = d.join("k.toml");
-    let out = ocular(&[
+    let out = ocular_run(&[
         "eye",
         "estimate",
         "--preset",
@@ -140,7 +113,7 @@ fn time_limit_writes_best_eye_marked_not_converged() {
 
 #[test]
 fn list_show_measure_draw() {
-    let list = ok(&ocular(&["eye", "list"]));
+    let list = ok(&ocular_run(&["eye", "list"]));
     for name in [
         "navarro",
         "healthy",
@@ -157,8 +130,8 @@ fn list_show_measure_draw() {
         assert!(r.converged && r.all_in_bounds, "{name}");
         assert!(r.rms_error_um <= 0.02, "{name}: {}", r.rms_error_um);
     }
-    ok(&ocular(&["eye", "show", "myopia"]));
-    let m: serde_json::Value = serde_json::from_str(&ok(&ocular(&[
+    ok(&ocular_run(&["eye", "show", "myopia"]));
+    let m: serde_json::Value = serde_json::from_str(&ok(&ocular_run(&[
         "eye",
         "measure",
         "navarro",
@@ -179,9 +152,9 @@ fn list_show_measure_draw() {
         .unwrap();
     assert!((c40 - 0.239).abs() < 0.005, "c40 {c40}");
     assert!(m["power_d"].as_f64().unwrap() > 55.0);
-    let d = scratch("draw");
+    let d = temp_dir("draw");
     let svg = d.join("eye.svg");
-    ok(&ocular(&[
+    ok(&ocular_run(&[
         "eye",
         "draw",
         "navarro",
@@ -193,7 +166,7 @@ fn list_show_measure_draw() {
 
 #[test]
 fn bad_input_is_refused_with_exit_code_2() {
-    let d = scratch("bad");
+    let d = temp_dir("bad");
     let out = d.join("never.toml");
     let o = out.to_str().unwrap();
     let nan = d.join("nan.toml");
@@ -246,16 +219,16 @@ fn bad_input_is_refused_with_exit_code_2() {
     for (args, word) in cases {
         let mut all = vec!["eye", "estimate", "-o", o];
         all.extend(args.iter());
-        refused(&ocular(&all), word);
+        refused(&ocular_run(&all), word);
         assert!(!out.exists(), "a refused run wrote {o}");
     }
     refused(
-        &ocular(&["eye", "show", bad_eye.to_str().unwrap()]),
+        &ocular_run(&["eye", "show", bad_eye.to_str().unwrap()]),
         "bad_eye.toml",
     );
-    refused(&ocular(&["eye", "show", "no-such-eye"]), "no-such-eye");
+    refused(&ocular_run(&["eye", "show", "no-such-eye"]), "no-such-eye");
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "eye",
             "measure",
             "navarro",
@@ -267,7 +240,7 @@ fn bad_input_is_refused_with_exit_code_2() {
         "--pupil-mm",
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "eye",
             "measure",
             "navarro",
@@ -284,9 +257,9 @@ fn bad_input_is_refused_with_exit_code_2() {
 
 #[test]
 fn ctrl_c_writes_best_eye_marked_not_converged() {
-    let d = scratch("sigint");
+    let d = temp_dir("sigint");
     let eye = d.join("k.toml");
-    let child = Command::new(env!("CARGO_BIN_EXE_ocular"))
+    let child = ocular()
         .args(["eye", "estimate", "--preset", "keratoconus", "-o"])
         .arg(&eye)
         .stdout(std::process::Stdio::piped())

@@ -1,29 +1,10 @@
 //! The front doors end to end on lavapipe with tiny frames: `render`, `video` (resume after a
 //! kill, byte-identical splits, bad ranges), `bench` (JSON a script can read) and `compare`.
 
-use std::path::{Path, PathBuf};
+use crate::common::{module_cache, ocular, temp_dir};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn ocular() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_ocular"));
-    c.stdin(Stdio::null());
-    c
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-frontdoors-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// A kernel cache shared by the tests of this file (they plan the same small grids).
-fn cache() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-frontdoors-cache-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The row of `compare --json`'s report for one method (or judged file).
 fn method_row(report: &serde_json::Value, name: &str) -> serde_json::Value {
@@ -67,7 +48,7 @@ fn render_writes_the_picture_and_reports_json() {
             .args([
                 "render", "--size", "160x90", "--eye", "navarro", "--json", "--cache",
             ])
-            .arg(cache())
+            .arg(module_cache())
             .arg("-o")
             .arg(&out),
     );
@@ -98,7 +79,7 @@ fn render_writes_the_picture_and_reports_json() {
                 "4",
                 "--cache",
             ])
-            .arg(cache())
+            .arg(module_cache())
             .arg("-o")
             .arg(&exr),
     );
@@ -160,7 +141,7 @@ fn video(dir: &Path, extra: &[&str]) -> Command {
         "10",
         "--cache",
     ])
-    .arg(cache())
+    .arg(module_cache())
     .arg("-o")
     .arg(dir)
     .args(extra);
@@ -295,7 +276,7 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
                 "bench", "--size", "160x90", "--eye", "navarro", "--warmup", "1", "--frames", "3",
                 "--cache",
             ])
-            .arg(cache())
+            .arg(module_cache())
             .arg("--json")
             .arg(&json),
     );
@@ -379,7 +360,7 @@ fn peeled_layers_stay_on_the_gpu_in_bench_and_render() {
                 "--baseline",
                 "--cache",
             ])
-            .arg(cache())
+            .arg(module_cache())
             .arg("--json")
             .arg(&json),
     );
@@ -405,7 +386,7 @@ fn peeled_layers_stay_on_the_gpu_in_bench_and_render() {
                 "render", "--size", "160x90", "--eye", "navarro", "--layers", "2", "--json",
                 "--cache",
             ])
-            .arg(cache())
+            .arg(module_cache())
             .arg("-o")
             .arg(dir.join("layers.png")),
     ))
@@ -429,7 +410,7 @@ fn compare_reports_quality_and_writes_maps() {
     run_ok(
         ocular()
             .args(["compare", "--size", "128x72", "--eye", "navarro", "--cache"])
-            .arg(cache())
+            .arg(module_cache())
             .arg("--json")
             .arg(&json)
             .arg("--maps")
@@ -476,7 +457,7 @@ fn compare_judges_saved_images_and_coarse_truths() {
     let (json, warm_json) = (dir.join("judge.json"), dir.join("warm.json"));
     let common = ["compare", "--size", "96x54", "--no-slices", "--cache"];
     let run = |extra: &[&std::ffi::OsStr]| {
-        run_ok(ocular().args(common).arg(cache()).args(extra));
+        run_ok(ocular().args(common).arg(module_cache()).args(extra));
     };
     run(&[
         "--truth-out".as_ref(),
@@ -547,7 +528,7 @@ fn render_uses_the_scene_resolution() {
             .arg("--scene")
             .arg(&scene_path)
             .args(["--eye", "navarro", "--cache"])
-            .arg(cache())
+            .arg(module_cache())
             .arg("-o")
             .arg(&out),
     );

@@ -1,18 +1,12 @@
 //! `ocular kernels` end to end on a tiny grid: files written, the cache hit on a second run,
 //! clear exit-2 errors for bad options.
 
+use crate::common::{ocular, temp_dir};
 use ocular::psf::cache::read_grid;
-use std::process::Command;
-
-fn ocular() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-}
 
 #[test]
 fn kernels_writes_grid_pictures_and_uses_the_cache() {
-    let dir = std::env::temp_dir().join(format!("ocular-cli-kernels-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("grid");
     let args = |json: bool| {
         let mut a: Vec<String> = [
             "kernels",
@@ -96,8 +90,7 @@ fn kernels_writes_grid_pictures_and_uses_the_cache() {
 /// pupil energy per column and channel, within 1e-3, and no warning on stderr.
 #[test]
 fn kernels_report_the_missed_pupil_energy_per_column() {
-    let dir = std::env::temp_dir().join(format!("ocular-cli-missed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("missed");
     let out = ocular()
         .args([
             "kernels",

@@ -3,25 +3,15 @@
 //! from its definition, the map file, and one-line exit-2 errors for bad input that leave no
 //! file behind.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use crate::common::{ocular, temp_dir};
+use std::path::Path;
+use std::process::Output;
 
 use ocular::image_io::{write_exr_rgba, ImageRgba};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/flip");
 const W: usize = 64;
 const H: usize = 48;
-
-fn ocular() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocular-metrics-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn read_f32(name: &str) -> Vec<f32> {
     std::fs::read(format!("{DATA}/{name}"))
@@ -75,7 +65,7 @@ fn s(p: &Path) -> &str {
 
 #[test]
 fn hdr_pair_gets_hdr_flip_as_the_reference_computes_it() {
-    let dir = scratch("hdr");
+    let dir = temp_dir("hdr");
     let (r, t, map) = (
         dir.join("ref.exr"),
         dir.join("test.exr"),
@@ -140,7 +130,7 @@ fn hdr_pair_gets_hdr_flip_as_the_reference_computes_it() {
 
 #[test]
 fn png_pair_gets_ldr_flip_psnr_and_ssim() {
-    let dir = scratch("ldr");
+    let dir = temp_dir("ldr");
     let (r, t) = (dir.join("ref.png"), dir.join("test.png"));
     let encode = |v: f32| {
         (ocular::metrics::flip::colour::linear_to_srgb(f64::from(v)) * 255.0).round() as u8
@@ -209,7 +199,7 @@ fn refused(args: &[&str], map: &Path, expect: &str) {
 
 #[test]
 fn bad_input_is_refused_with_exit_2() {
-    let dir = scratch("bad");
+    let dir = temp_dir("bad");
     let map = dir.join("map.png");
     let (a, small, nan, black, garbage, p) = (
         dir.join("a.exr"),
@@ -297,7 +287,7 @@ fn bad_input_is_refused_with_exit_2() {
 fn compare_reports_flip_of_the_displayed_images() {
     use ocular::metrics::flip::{ldr_flip, FlipStats};
     use ocular::metrics::ImageView;
-    let dir = scratch("compare");
+    let dir = temp_dir("compare");
     let (w, h) = (96usize, 54usize);
     let truth: Vec<f32> = (0..w * h * 3)
         .map(|i| {

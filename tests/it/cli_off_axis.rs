@@ -2,25 +2,12 @@
 //! used), its range checks, and the retina in eye files (old files load with the wide-angle
 //! retina, a plane is accepted, bad radii and unknown shapes are refused).
 
+use crate::common::{ocular_run, refused, temp_dir};
 use ocular::eye::{Eye, Retina};
-use std::process::{Command, Output};
-
-fn ocular(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn refused(out: &Output, word: &str) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(err.contains(word), "expected {word:?} in {err}");
-}
+use std::process::Output;
 
 fn measure_json(field: &str) -> serde_json::Value {
-    let out = ocular(&[
+    let out = ocular_run(&[
         "eye",
         "measure",
         "navarro-wide",
@@ -68,7 +55,7 @@ fn measure_off_axis_prints_the_on_axis_json_and_its_pupil() {
 #[test]
 fn field_option_is_range_checked() {
     for bad in ["61,0", "0,-70", "55,55", "nan,0", "10", "a,b", "1,2,3"] {
-        let out = ocular(&[
+        let out = ocular_run(&[
             "eye",
             "measure",
             "navarro-wide",
@@ -79,7 +66,7 @@ fn field_option_is_range_checked() {
             "--field-deg",
             bad,
         ]);
-        refused(&out, "--field-deg");
+        refused(&out, &["--field-deg"]);
     }
 }
 
@@ -132,7 +119,7 @@ fn kernels(dir: &std::path::Path, extra: &[&str]) -> Output {
     if !extra.contains(&"--no-cache") {
         args.extend_from_slice(&["--cache", &cache]);
     }
-    ocular(&args)
+    ocular_run(&args)
 }
 
 /// Grids over the field: an index and one grid per direction, each cached on its own (a
@@ -141,9 +128,7 @@ fn kernels(dir: &std::path::Path, extra: &[&str]) -> Output {
 #[test]
 fn kernels_over_the_field_are_written_and_cached_per_direction() {
     use ocular::psf::cache::read_grid;
-    let dir = std::env::temp_dir().join(format!("ocular-off-axis-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("field");
     let index = dir.join("field.toml");
     let out = kernels(
         &dir,
@@ -202,7 +187,7 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     ] {
         let mut a = bad.clone();
         a.extend_from_slice(&["-o", index.to_str().unwrap()]);
-        refused(&kernels(&dir, &a), "--field-deg");
+        refused(&kernels(&dir, &a), &["--field-deg"]);
     }
     // auto: the frame's range (160 × 180 px at 40°) at measured steps.
     let auto = dir.join("auto.toml");
@@ -241,7 +226,7 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
                 auto.to_str().unwrap(),
             ],
         ),
-        "--width",
+        &["--width"],
     );
     let png = dir.join("p.png");
     let mut a = vec![
@@ -251,7 +236,7 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
         index.to_str().unwrap(),
     ];
     a.extend_from_slice(&["--preview", png.to_str().unwrap()]);
-    refused(&kernels(&dir, &a), "--field-deg");
+    refused(&kernels(&dir, &a), &["--field-deg"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -259,10 +244,9 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
 /// the slice method and the views truth stay on axis.
 #[test]
 fn off_axis_is_refused_where_it_does_not_apply() {
-    let dir = std::env::temp_dir().join(format!("ocular-off-axis-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("refused");
     let png = dir.join("x.png");
-    let out = ocular(&[
+    let out = ocular_run(&[
         "render",
         "--scene",
         "primitives",
@@ -275,9 +259,9 @@ fn off_axis_is_refused_where_it_does_not_apply() {
         "-o",
         png.to_str().unwrap(),
     ]);
-    refused(&out, "--off-axis");
+    refused(&out, &["--off-axis"]);
     assert!(!png.exists(), "no output for a refused render");
-    let out = ocular(&[
+    let out = ocular_run(&[
         "compare",
         "--scene",
         "primitives",
@@ -288,6 +272,6 @@ fn off_axis_is_refused_where_it_does_not_apply() {
         "--off-axis",
         "--no-cache",
     ]);
-    refused(&out, "--off-axis");
+    refused(&out, &["--off-axis"]);
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -2,37 +2,9 @@
 //! the option the user gave (defects 9, 10, 11) and small input conveniences work (defect 13).
 //! None of these runs renders: every refusal happens before the GPU or the optics start.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-fn ocular(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .stdin(Stdio::null())
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocular-outputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
-
-/// Exit 2 and one line naming every word.
-fn refused(out: &Output, words: &[&str]) {
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
-    for w in words {
-        assert!(err.contains(w), "expected {w:?} in {err}");
-    }
-}
+use crate::common::{ocular, ocular_run, p, refused, temp_dir};
+use std::path::Path;
+use std::process::{Command, Stdio};
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
@@ -46,18 +18,18 @@ fn files_in(dir: &Path) -> Vec<String> {
 
 #[test]
 fn outputs_must_be_named_for_their_format() {
-    let d = scratch("ext");
+    let d = temp_dir("ext");
     let png = d.join("p.png");
     refused(
-        &ocular(&["psf", "--preset", "healthy", "--size", "32", "-o", p(&png)]),
+        &ocular_run(&["psf", "--preset", "healthy", "--size", "32", "-o", p(&png)]),
         &["-o", "p.png", ".exr"],
     );
     refused(
-        &ocular(&["raster", "--scene", "primitives", "-o", p(&d.join("c.png"))]),
+        &ocular_run(&["raster", "--scene", "primitives", "-o", p(&d.join("c.png"))]),
         &["-o", "c.png", ".exr"],
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "raster",
             "--scene",
             "primitives",
@@ -67,7 +39,7 @@ fn outputs_must_be_named_for_their_format() {
         &["--png", ".png"],
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "compare",
             "--size",
             "64x36",
@@ -77,7 +49,7 @@ fn outputs_must_be_named_for_their_format() {
         &["--truth-out", "t.png", ".exr"],
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "kernels",
             "--eye",
             "navarro",
@@ -93,10 +65,10 @@ fn outputs_must_be_named_for_their_format() {
 
 #[test]
 fn one_path_for_two_outputs_is_refused() {
-    let d = scratch("same");
+    let d = temp_dir("same");
     let x = d.join("x.exr");
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "raster",
             "--scene",
             "primitives",
@@ -109,7 +81,7 @@ fn one_path_for_two_outputs_is_refused() {
     );
     // psf writes a JSON sidecar next to its EXR: a --png cannot take that name either.
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "psf",
             "--preset",
             "healthy",
@@ -127,10 +99,10 @@ fn one_path_for_two_outputs_is_refused() {
 
 #[test]
 fn a_failing_second_output_leaves_nothing_behind() {
-    let d = scratch("partial");
+    let d = temp_dir("partial");
     let nodir = d.join("nodir");
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "psf",
             "--preset",
             "healthy",
@@ -144,7 +116,7 @@ fn a_failing_second_output_leaves_nothing_behind() {
         &["--png", "does not exist"],
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "raster",
             "--scene",
             "primitives",
@@ -156,7 +128,7 @@ fn a_failing_second_output_leaves_nothing_behind() {
         &["--depth-out", "does not exist"],
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "kernels",
             "--eye",
             "navarro",
@@ -176,14 +148,14 @@ fn a_failing_second_output_leaves_nothing_behind() {
     );
     // Like every other command, kernels does not create a missing folder for -o.
     refused(
-        &ocular(&["kernels", "--eye", "navarro", "-o", p(&nodir.join("g.bin"))]),
+        &ocular_run(&["kernels", "--eye", "navarro", "-o", p(&nodir.join("g.bin"))]),
         &["-o", "does not exist"],
     );
     assert!(!nodir.exists());
     assert!(files_in(&d).is_empty(), "{:?}", files_in(&d));
 
     // A psf run that succeeds writes all three files and no temporaries.
-    let out = ocular(&[
+    let out = ocular_run(&[
         "psf",
         "--preset",
         "myopia",
@@ -206,7 +178,7 @@ fn a_failing_second_output_leaves_nothing_behind() {
 
 #[test]
 fn compare_refuses_a_ground_truth_holding_nan() {
-    let d = scratch("nan");
+    let d = temp_dir("nan");
     let truth = d.join("truth.exr");
     let mut pixels = vec![[0.5f32, 0.5, 0.5, 1.0]; 64 * 36];
     pixels[3 * 64 + 5][1] = f32::NAN;
@@ -214,21 +186,21 @@ fn compare_refuses_a_ground_truth_holding_nan() {
     ocular::image_io::write_exr_rgba(&truth, &ocular::image_io::ImageRgba::new(64, 36, pixels))
         .unwrap();
     refused(
-        &ocular(&["compare", "--size", "64x36", "--truth-in", p(&truth)]),
+        &ocular_run(&["compare", "--size", "64x36", "--truth-in", p(&truth)]),
         &["--truth-in", "2 pixels", "x = 5, y = 3"],
     );
 }
 
 #[test]
 fn compare_judge_and_truth_bin_are_checked_before_rendering() {
-    let d = scratch("judge");
+    let d = temp_dir("judge");
     let nan = d.join("other.exr");
     let mut pixels = vec![[0.5f32, 0.5, 0.5, 1.0]; 64 * 36];
     pixels[2 * 64 + 9][2] = f32::NAN;
     ocular::image_io::write_exr_rgba(&nan, &ocular::image_io::ImageRgba::new(64, 36, pixels))
         .unwrap();
     refused(
-        &ocular(&["compare", "--size", "64x36", "--judge", p(&nan)]),
+        &ocular_run(&["compare", "--size", "64x36", "--judge", p(&nan)]),
         &["--judge", "other.exr", "1 pixels", "x = 9, y = 2"],
     );
     let small = d.join("small.exr");
@@ -238,18 +210,18 @@ fn compare_judge_and_truth_bin_are_checked_before_rendering() {
     )
     .unwrap();
     refused(
-        &ocular(&["compare", "--size", "64x36", "--judge", p(&small)]),
+        &ocular_run(&["compare", "--size", "64x36", "--judge", p(&small)]),
         &["--judge", "small.exr", "32×18", "64×36"],
     );
     let named_splat = d.join("splat.exr");
     std::fs::copy(&small, &named_splat).unwrap();
     refused(
-        &ocular(&["compare", "--judge", p(&named_splat)]),
+        &ocular_run(&["compare", "--judge", p(&named_splat)]),
         &["--judge", "splat.exr", "`splat`"],
     );
     // clap's parser errors add a hint line; the first line names the option and the value
     for bad in ["0", "0.2", "x"] {
-        let out = ocular(&["compare", "--truth-bin-d", bad]);
+        let out = ocular_run(&["compare", "--truth-bin-d", bad]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{err}");
         let first = err.lines().next().unwrap_or_default();
@@ -259,21 +231,21 @@ fn compare_judge_and_truth_bin_are_checked_before_rendering() {
         );
     }
     refused(
-        &ocular(&["compare", "--truth-bin-d", "0.01", "--truth-in", p(&small)]),
+        &ocular_run(&["compare", "--truth-bin-d", "0.01", "--truth-in", p(&small)]),
         &["--truth-bin-d", "--truth-in"],
     );
 }
 
 #[test]
 fn frame_sizes_are_checked_where_they_are_parsed() {
-    let d = scratch("size");
+    let d = temp_dir("size");
     let frames = d.join("frames");
     for cmd in ["video", "compare", "bench"] {
         let mut args = vec![cmd, "--size", "1x1"];
         if cmd == "video" {
             args.extend(["--scene", "primitives", "-o", p(&frames)]);
         }
-        let out = ocular(&args);
+        let out = ocular_run(&args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{cmd}: {err}");
         // The parser states the real limit, naming the option and the value given.
@@ -288,18 +260,18 @@ fn frame_sizes_are_checked_where_they_are_parsed() {
 #[test]
 fn compare_names_its_own_options() {
     refused(
-        &ocular(&["compare", "--size", "64x36", "--object-samples", "0"]),
+        &ocular_run(&["compare", "--size", "64x36", "--object-samples", "0"]),
         &["--object-samples 0", "2 to 1024"],
     );
     refused(
-        &ocular(&["compare", "--size", "64x36", "--object-samples", "100000"]),
+        &ocular_run(&["compare", "--size", "64x36", "--object-samples", "100000"]),
         &["--object-samples 100000"],
     );
 }
 
 #[test]
 fn psf_errors_name_the_options_given() {
-    let d = scratch("psf-names");
+    let d = temp_dir("psf-names");
     let out = d.join("p.exr");
     for (extra, want) in [
         (&["--defocus-d", "1000"][..], "--defocus-d 1000"),
@@ -308,7 +280,7 @@ fn psf_errors_name_the_options_given() {
     ] {
         let mut args = vec!["psf", "--preset", "healthy", "-o", p(&out)];
         args.extend_from_slice(extra);
-        let o = ocular(&args);
+        let o = ocular_run(&args);
         refused(&o, &[want]);
         let err = String::from_utf8_lossy(&o.stderr);
         for internal in [
@@ -324,11 +296,11 @@ fn psf_errors_name_the_options_given() {
 
 #[test]
 fn device_is_an_index_or_a_name_and_cpu_commands_refuse_it() {
-    let d = scratch("device");
+    let d = temp_dir("device");
     // One device is listed on the test machine; 5 is no index, and must not match "15.0.6".
-    refused(&ocular(&["--device", "5", "devices"]), &["\"5\""]);
+    refused(&ocular_run(&["--device", "5", "devices"]), &["\"5\""]);
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "--device",
             "0",
             "psf",
@@ -340,7 +312,7 @@ fn device_is_an_index_or_a_name_and_cpu_commands_refuse_it() {
         &["--device", "psf", "CPU"],
     );
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "kernels",
             "--eye",
             "navarro",
@@ -352,11 +324,11 @@ fn device_is_an_index_or_a_name_and_cpu_commands_refuse_it() {
         &["--device", "kernels"],
     );
     refused(
-        &ocular(&["eye", "list", "--device", "0"]),
+        &ocular_run(&["eye", "list", "--device", "0"]),
         &["--device", "eye"],
     );
     // OCULAR_DEVICE is a preference for GPU commands: the CPU ones run with it set.
-    let out = Command::new(env!("CARGO_BIN_EXE_ocular"))
+    let out = ocular()
         .env("OCULAR_DEVICE", "0")
         .args(["eye", "list"])
         .output()
@@ -367,9 +339,9 @@ fn device_is_an_index_or_a_name_and_cpu_commands_refuse_it() {
 
 #[test]
 fn eye_estimate_term_needs_rx_and_csv_may_carry_a_bom() {
-    let d = scratch("eye");
+    let d = temp_dir("eye");
     refused(
-        &ocular(&[
+        &ocular_run(&[
             "eye",
             "estimate",
             "--preset",
@@ -387,7 +359,7 @@ fn eye_estimate_term_needs_rx_and_csv_may_carry_a_bom() {
         "\u{feff}j,coefficient_um\n# pupil_diameter_mm = 5\n# wavelength_nm = 555\n4,1.2\n12,0.05\n",
     )
     .unwrap();
-    let out = ocular(&[
+    let out = ocular_run(&[
         "psf",
         "--zernike",
         p(&csv),
@@ -408,7 +380,7 @@ fn eye_estimate_term_needs_rx_and_csv_may_carry_a_bom() {
     assert_eq!(sidecar["pupil_mm"], 5.0);
     assert_eq!(sidecar["coefficients"].as_array().unwrap().len(), 2);
 
-    let list = String::from_utf8_lossy(&ocular(&["eye", "list"]).stdout).into_owned();
+    let list = String::from_utf8_lossy(&ocular_run(&["eye", "list"]).stdout).into_owned();
     assert!(
         !list.contains("1 terms") && !list.contains("order 0"),
         "{list}"
@@ -422,9 +394,9 @@ fn eye_estimate_term_needs_rx_and_csv_may_carry_a_bom() {
 /// Sends `signal` to a running estimate; it must write the best eye (not converged) and exit
 /// with 128 + the signal number, so a script can tell a cancelled fit from a converged one.
 fn cancelled_estimate(signal: &str, code: i32) {
-    let d = scratch(&format!("cancel-{signal}"));
+    let d = temp_dir(&format!("cancel-{signal}"));
     let eye = d.join("k.toml");
-    let child = Command::new(env!("CARGO_BIN_EXE_ocular"))
+    let child = ocular()
         .args(["eye", "estimate", "--preset", "keratoconus", "-o", p(&eye)])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

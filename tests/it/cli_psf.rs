@@ -1,18 +1,7 @@
 //! `ocular psf` end to end: the EXR is normalised with the optical axis at (N/2, N/2), the
 //! sidecar carries the inputs and accuracy figures, and bad input is exit 2 with no file.
 
-use std::process::Command;
-
-fn ocular() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-}
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-cli-psf-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::{ocular, temp_dir};
 
 #[test]
 fn healthy_psf_is_normalised_and_centred() {

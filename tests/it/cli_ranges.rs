@@ -3,23 +3,8 @@
 //! just outside the bound with exit 2 and a message that names the option or field and states
 //! the one shared range; a value on the bound passes the same check.
 
+use crate::common::{ocular_run, temp_dir};
 use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
-
-fn ocular(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .unwrap()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-ranges-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The primitives scene with one line replaced, written into `dir`.
 fn primitives_with(dir: &std::path::Path, line: &str, by: &str) -> PathBuf {
@@ -34,7 +19,7 @@ fn primitives_with(dir: &std::path::Path, line: &str, by: &str) -> PathBuf {
 }
 
 fn refused(args: &[&str], names: &str, allowed: &str) {
-    let out = ocular(args);
+    let out = ocular_run(args);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
     assert!(
@@ -107,7 +92,7 @@ fn pupil_range_is_the_same_everywhere() {
         );
     }
     // On the bound: the same checks pass (eye measure is the cheapest command that traces).
-    let ok = ocular(&[
+    let ok = ocular_run(&[
         "eye",
         "measure",
         "navarro",
@@ -181,7 +166,7 @@ fn wavelength_range_is_the_same_everywhere() {
             WAVELENGTH,
         );
     }
-    let ok = ocular(&[
+    let ok = ocular_run(&[
         "eye",
         "measure",
         "navarro",

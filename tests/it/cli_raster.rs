@@ -1,24 +1,6 @@
 //! `ocular raster` end to end: outputs on success, one clear line and exit code 2 on bad input.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn ocular() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-}
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::{data, ocular, temp_dir};
 
 #[test]
 fn raster_writes_colour_depth_and_preview() {

@@ -2,49 +2,32 @@
 //! non-finite colour and exposure), end to end on lavapipe with 16×16 frames.
 
 use crate::common;
+use crate::common::{json_ok, module_cache, ocular, p, temp_dir};
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::path::Path;
+use std::process::Output;
 
 use common::blender::{combined, cycles_layer, depth_values, plane, write_single_part};
 
 const SIZE: (usize, usize) = (16, 16);
 const N: usize = SIZE.0 * SIZE.1;
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-cli-inputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn cache() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-cli-inputs-cache-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// `ocular render` with the shared cache, a 4 mm pupil unless `args` sets the pupil, and `out`.
 fn render(args: &[&str], out: &Path) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_ocular"));
-    c.stdin(Stdio::null()).arg("render").args(args);
+    let mut c = ocular();
+    c.arg("render").args(args);
     if !args
         .iter()
         .any(|a| a.starts_with("--pupil") || a.starts_with("--luminance"))
     {
         c.args(["--pupil-mm", "4"]);
     }
-    c.arg("--cache").arg(cache()).arg("-o").arg(out);
+    c.arg("--cache").arg(module_cache()).arg("-o").arg(out);
     c.output().unwrap()
 }
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn json_ok(o: &Output) -> serde_json::Value {
-    assert!(o.status.success(), "failed: {}", stderr(o));
-    serde_json::from_slice(&o.stdout).unwrap()
 }
 
 /// Exit 2, one `error:` line containing every `want`, and no output file.
@@ -59,10 +42,6 @@ fn refused(o: &Output, out: &Path, want: &[&str]) {
         assert!(text.contains(w), "{w:?} not in {text}");
     }
     assert!(!out.exists(), "an output was written");
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
 }
 
 #[test]

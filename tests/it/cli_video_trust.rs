@@ -3,21 +3,9 @@
 //! rather than skipped, splits are byte-identical in both formats, and `--mp4` is checked
 //! before any frame is rendered.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-trust-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn cache() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-trust-cache-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::common::{module_cache, ocular, ok, refused, temp_dir};
+use std::path::Path;
+use std::process::{Command, Output};
 
 /// Four 160×90 frames of a focus sweep; an option in `extra` replaces its default.
 fn video(dir: &Path, extra: &[&str]) -> Output {
@@ -29,39 +17,20 @@ fn video(dir: &Path, extra: &[&str]) -> Output {
         ("--duration", "0.4"),
         ("--fps", "10"),
     ];
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_ocular"));
-    cmd.stdin(Stdio::null()).arg("video");
+    let mut cmd = ocular();
+    cmd.arg("video");
     for (option, value) in defaults {
         if !extra.contains(&option) {
             cmd.args([option, value]);
         }
     }
     cmd.arg("--cache")
-        .arg(cache())
+        .arg(module_cache())
         .arg("-o")
         .arg(dir)
         .args(extra)
         .output()
         .unwrap()
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn refused(out: &Output, words: &[&str]) -> String {
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
-    for w in words {
-        assert!(err.contains(w), "{w:?} missing from: {err}");
-    }
-    err
 }
 
 fn frames(dir: &Path) -> Vec<(String, Vec<u8>)> {
@@ -194,7 +163,7 @@ fn exr_splits_are_byte_identical_to_one_run() {
 #[test]
 fn mp4_without_ffmpeg_fails_before_rendering() {
     let dir = temp_dir("mp4");
-    let out = Command::new(env!("CARGO_BIN_EXE_ocular"))
+    let out = ocular()
         .env("PATH", "/nonexistent")
         .args([
             "video",

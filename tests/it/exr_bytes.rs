@@ -1,14 +1,8 @@
 //! EXR output is byte-deterministic: identical pixels give identical files (issue 20, defect 6),
 //! which checksums, caches and split verification depend on.
 
+use crate::common::temp_dir;
 use ocular::image_io::{write_exr_depth, write_exr_rgba, ImageGray, ImageRgba};
-
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-exr-bytes-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Noise that RLE cannot shrink, so every tile costs a different compression time and a
 /// writer that emits blocks as they finish would vary its order.

@@ -1,19 +1,13 @@
 //! EXR and PNG reading and writing: round trips, channel choice, and atomic writes.
 
-use std::path::{Path, PathBuf};
+use crate::common::temp_dir;
+use std::path::Path;
 
 use ocular::image_io::{
     read_exr_depth, read_exr_depth_channel, read_exr_rgba, write_exr_depth, write_exr_gray,
     write_exr_rgba, write_png, ImageGray, ImageRgba, Tonemap, TonemapMode,
 };
 use ocular::Error;
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn test_rgba(width: u32, height: u32) -> ImageRgba {
     let pixels = (0..width * height)

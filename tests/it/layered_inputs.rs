@@ -2,9 +2,9 @@
 //! the partial-occlusion options (--views, --layers, --truth views).
 
 use crate::common;
+use crate::common::{ocular_run, temp_dir};
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use common::blender::{plane, write_multi_part, Plane};
 use ocular::inputs::{load, FileInputOptions};
@@ -22,12 +22,6 @@ fn options(color: &Path) -> FileInputOptions {
         white_cdm2: None,
         repair_nonfinite: false,
     }
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-layered-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn layer(value: f32, z: impl Fn(usize) -> f32) -> Vec<Plane> {
@@ -108,11 +102,8 @@ fn a_gap_or_a_missing_channel_is_refused() {
     assert!(e.contains("no channel Z"), "{e}");
 }
 
-fn ocular(args: &[&str]) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .args(args)
-        .output()
-        .unwrap();
+fn code_and_stderr(args: &[&str]) -> (i32, String) {
+    let out = ocular_run(args);
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stderr).to_string(),
@@ -150,12 +141,12 @@ fn new_options_are_range_checked_where_parsed() {
             "--views applies to --truth views",
         ),
     ] {
-        let (code, err) = ocular(&args);
+        let (code, err) = code_and_stderr(&args);
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(err.trim().lines().count() <= 3, "{args:?}: {err}");
     }
-    let (code, err) = ocular(&[
+    let (code, err) = code_and_stderr(&[
         "render", "--method", "views", "--color", "x.exr", "--fov-y", "30",
     ]);
     assert_eq!(code, 2, "{err}");

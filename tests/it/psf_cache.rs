@@ -1,20 +1,13 @@
 //! Kernel grid files and the cache: round trip, and every kind of damage is detected, reported
 //! and recomputed, never loaded.
 
+use crate::common::temp_dir;
 use ocular::eye::Eye;
 use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
 use ocular::psf::cache::{cache_path, cached, grid_key, read_grid, write_grid, CacheOutcome};
 use ocular::psf::grid::{compute_grid, no_progress, GridReport};
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};
 use std::cell::Cell;
-use std::path::PathBuf;
-
-fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocular-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn inputs() -> (Eye, GridAxes, Screen, KernelSettings) {
     (
@@ -40,7 +33,7 @@ fn compute() -> (KernelGrid, GridReport) {
 
 #[test]
 fn grid_files_round_trip_and_damage_is_detected() {
-    let dir = tmp_dir("file");
+    let dir = temp_dir("file");
     let (grid, _) = compute();
     let path = dir.join("grid.bin");
     write_grid(&path, &grid, "k1").unwrap();
@@ -81,7 +74,7 @@ fn grid_files_round_trip_and_damage_is_detected() {
 
 #[test]
 fn the_cache_hits_and_recomputes_a_corrupted_file() {
-    let dir = tmp_dir("cache");
+    let dir = temp_dir("cache");
     let (eye, axes, screen, settings) = inputs();
     let key = grid_key(&eye, &axes, &screen, &settings);
     let runs = Cell::new(0);

@@ -4,8 +4,9 @@
 //! fails the assertions instead of passing by coincidence.
 
 use crate::common;
+use crate::common::temp_dir;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use common::blender::{
     combined, cycles_layer, depth_values, half_plane, plane, write_multi_part, write_single_part,
@@ -14,13 +15,6 @@ use common::blender::{
 use ocular::inputs::{self, FileInputOptions};
 
 const SIZE: (usize, usize) = (16, 16);
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-inputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn options(color: &Path) -> FileInputOptions {
     FileInputOptions {

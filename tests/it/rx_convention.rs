@@ -6,35 +6,10 @@
 //! conversion formula. Negative control: an eye built with the prescription at the cornea (the
 //! old convention, `--vertex-mm 0`), seen through the same lens at 12 mm, misses both bars.
 
-use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
+use crate::common::{json_ok, ocular_run, temp_dir};
 
 const CORRECTED_BAR_D: f64 = 0.12;
 const REFRACT_BAR_D: f64 = 0.06;
-
-fn ocular(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .stdin(Stdio::null())
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn json_ok(o: &Output) -> serde_json::Value {
-    assert!(
-        o.status.success(),
-        "failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-rx-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Thibos power vector of sphere, cylinder and axis, written here for the test.
 fn power_vector(s: f64, c: f64, a_deg: f64) -> [f64; 3] {
@@ -66,9 +41,9 @@ fn round_trip(dir: &std::path::Path, rx: (f64, f64, f64), extra: &[&str]) -> (f6
         eye,
     ];
     args.extend(extra);
-    let o = ocular(&args);
+    let o = ocular_run(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let m = json_ok(&ocular(&[
+    let m = json_ok(&ocular_run(&[
         "eye",
         "measure",
         eye,
@@ -84,7 +59,7 @@ fn round_trip(dir: &std::path::Path, rx: (f64, f64, f64), extra: &[&str]) -> (f6
         .iter()
         .map(|k| m["refraction"][k].as_f64().unwrap().abs())
         .fold(0.0, f64::max);
-    let r = json_ok(&ocular(&[
+    let r = json_ok(&ocular_run(&[
         "eye",
         "refract",
         eye,
@@ -145,7 +120,7 @@ fn the_vertex_of_the_prescription_is_an_option_and_the_cornea_plane_misses_the_b
     assert!(residual < CORRECTED_BAR_D && refract_error < REFRACT_BAR_D);
     // A contact-lens prescription corrects as a contact lens.
     let eye = dir.join("eye.toml");
-    let o = ocular(&[
+    let o = ocular_run(&[
         "eye",
         "estimate",
         "--rx",
@@ -160,7 +135,7 @@ fn the_vertex_of_the_prescription_is_an_option_and_the_cornea_plane_misses_the_b
         eye.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let through = json_ok(&ocular(&[
+    let through = json_ok(&ocular_run(&[
         "eye",
         "measure",
         eye.to_str().unwrap(),
@@ -177,7 +152,7 @@ fn the_vertex_of_the_prescription_is_an_option_and_the_cornea_plane_misses_the_b
     assert!(left.abs() < CORRECTED_BAR_D, "contact lens: M = {left}");
     // Bad vertex distances are refused with the option named.
     for bad in ["17", "-1", "nan"] {
-        let o = ocular(&[
+        let o = ocular_run(&[
             "eye",
             "estimate",
             "--rx",

@@ -1,18 +1,13 @@
 //! Scene files, OBJ loading and animation, on the CPU: what parses, what is rejected and with
 //! which file and line, and how keyframes interpolate.
 
-use std::path::{Path, PathBuf};
+use crate::common::data;
+use std::path::Path;
 
 use ocular::scene::obj;
 use ocular::scene::optotype::letter_height_m;
 use ocular::scene::{Scene, Track};
 use ocular::Error;
-
-fn data(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-}
 
 /// The error's file and message, asserting it is a file error (exit code 2).
 fn file_error(result: Result<impl std::fmt::Debug, Error>) -> (String, String) {

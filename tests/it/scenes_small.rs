@@ -8,9 +8,7 @@
 //! invent one). The CLI level renders and exports each scene at 64×36 and 160×90.
 
 use crate::common;
-
-use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use crate::common::{ocular, temp_dir};
 
 use ocular::psf::axes::{GridAxes, Screen};
 use ocular::psf::plan::plan_for_scene;
@@ -95,16 +93,8 @@ fn shipped_scenes_have_physical_depth_and_a_kernel_plan_at_every_size() {
     common::finish(ctx);
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ocular-small-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn run(args: &[&str], cache: &std::path::Path) {
-    let out = Command::new(env!("CARGO_BIN_EXE_ocular"))
-        .stdin(Stdio::null())
+    let out = ocular()
         .args(args)
         .arg("--cache")
         .arg(cache)
