@@ -4,25 +4,11 @@
 use crate::common;
 use crate::common::{ocular_run, temp_dir};
 
-use std::path::Path;
-
-use common::blender::{plane, write_multi_part, Plane};
-use ocular::inputs::{load, FileInputOptions};
+use common::blender::{options, plane, write_multi_part, Plane};
+use ocular::inputs::load;
 
 const W: usize = 16;
 const H: usize = 8;
-
-fn options(color: &Path) -> FileInputOptions {
-    FileInputOptions {
-        color: color.to_path_buf(),
-        depth: None,
-        color_layer: None,
-        depth_channel: None,
-        depth_scale: 1.0,
-        white_cdm2: None,
-        repair_nonfinite: false,
-    }
-}
 
 fn layer(value: f32, z: impl Fn(usize) -> f32) -> Vec<Plane> {
     let n = W * H;

@@ -2,8 +2,7 @@
 //! scenes, and the graphics-pipeline layer's own checks.
 
 use crate::common;
-
-use std::path::Path;
+use crate::common::scenes::{scene, square_scene};
 
 use ocular::gpu::{
     BindingKind, DepthCompare, GpuError, GraphicsPipeline, Image, ImageUsage, TexelFormat,
@@ -12,10 +11,6 @@ use ocular::gpu::{
 use ocular::image_io::luminance;
 use ocular::render::Rasterizer;
 use ocular::scene::Scene;
-
-fn scene(text: &str) -> Scene {
-    Scene::from_toml(text, "test scene", Path::new(".")).unwrap()
-}
 
 #[test]
 fn plane_facing_the_camera_has_its_distance_as_depth_everywhere() {
@@ -97,28 +92,6 @@ rotate_deg = [-90.0, 0.0, 0.0]
     assert!(worst < 1e-4, "relative error {worst}");
     drop(raster);
     common::finish(ctx);
-}
-
-/// A self-lit square of half-width `half_m` at `distance_m` on the axis: black background, no
-/// lights, so colour is coverage × emission exactly.
-fn square_scene(half_m: f64, distance_m: f64, fov_y_deg: f64) -> Scene {
-    scene(&format!(
-        r#"
-[camera]
-position = [0.0, 0.0, 0.0]
-fov_y_deg = {fov_y_deg}
-far_m = 100.0
-
-[[object]]
-kind = "plane"
-size_m = {}
-translate = [0.0, 0.0, {}]
-color = [0.0, 0.0, 0.0]
-emission_cd_m2 = 100.0
-"#,
-        2.0 * half_m,
-        -distance_m
-    ))
 }
 
 #[test]
@@ -424,8 +397,7 @@ color = [0.5, 0.5, 0.5]
 
 #[test]
 fn textures_are_srgb_decoded_and_mapped_across_the_surface() {
-    let dir = std::env::temp_dir().join(format!("ocular-texture-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::temp_dir("texture");
     // Left half mid-grey (sRGB 128), right half pure red.
     let texture = image::RgbaImage::from_fn(4, 1, |x, _| {
         if x < 2 {

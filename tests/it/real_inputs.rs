@@ -6,27 +6,13 @@
 use crate::common;
 use crate::common::temp_dir;
 
-use std::path::Path;
-
 use common::blender::{
-    combined, cycles_layer, depth_values, half_plane, plane, write_multi_part, write_single_part,
-    write_views,
+    combined, cycles_layer, depth_values, half_plane, options, plane, write_multi_part,
+    write_single_part, write_views,
 };
 use ocular::inputs::{self, FileInputOptions};
 
 const SIZE: (usize, usize) = (16, 16);
-
-fn options(color: &Path) -> FileInputOptions {
-    FileInputOptions {
-        color: color.to_path_buf(),
-        depth: None,
-        color_layer: None,
-        depth_channel: None,
-        depth_scale: 1.0,
-        white_cdm2: None,
-        repair_nonfinite: false,
-    }
-}
 
 fn error_of(options: &FileInputOptions) -> (i32, String) {
     let e = inputs::load(options).unwrap_err();

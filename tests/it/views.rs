@@ -3,8 +3,7 @@
 //! centroid of any PSF is the mean ray aberration, diffraction or not), and its convergence.
 
 use crate::common;
-
-use std::path::Path;
+use crate::common::scenes::square_scene;
 
 use ocular::eye::file::resolve;
 use ocular::metrics::{psnr, ImageView};
@@ -14,32 +13,6 @@ use ocular::psf::exact::ExactEye;
 use ocular::render::views;
 use ocular::render::Rasterizer;
 use ocular::scene::Scene;
-
-/// A self-lit square of half-width `half_m` at `distance_m` on the axis, black around it.
-fn square_scene(half_m: f64, distance_m: f64, fov_y_deg: f64) -> Scene {
-    Scene::from_toml(
-        &format!(
-            r#"
-[camera]
-position = [0.0, 0.0, 0.0]
-fov_y_deg = {fov_y_deg}
-far_m = 100.0
-
-[[object]]
-kind = "plane"
-size_m = {}
-translate = [0.0, 0.0, {}]
-color = [0.0, 0.0, 0.0]
-emission_cd_m2 = 100.0
-"#,
-            2.0 * half_m,
-            -distance_m
-        ),
-        "test scene",
-        Path::new("."),
-    )
-    .unwrap()
-}
 
 /// Energy, centroid (x, y) and variance (x, y) of one channel, pixel centres at integers.
 fn moments(image: &[[f32; 4]], w: usize, c: usize) -> (f64, [f64; 2], [f64; 2]) {

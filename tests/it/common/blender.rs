@@ -1,10 +1,10 @@
 //! Synthetic EXR files with the exact channel names Blender 3.4 writes (recorded from Cycles
 //! and Eevee renders; see issue 19), for the input tests.
-#![allow(dead_code)]
 
 use std::path::Path;
 
 use exr::prelude::*;
+use ocular::inputs::FileInputOptions;
 
 /// One channel: its full name and a value per pixel.
 pub struct Plane {
@@ -153,4 +153,17 @@ pub fn cycles_layer(layer: &str, size: (usize, usize), base: f32, near: f32) -> 
         ));
     }
     planes
+}
+
+/// Options that load `color` alone: no depth file, layer or channel chosen, scale 1, no repair.
+pub fn options(color: &Path) -> FileInputOptions {
+    FileInputOptions {
+        color: color.to_path_buf(),
+        depth: None,
+        color_layer: None,
+        depth_channel: None,
+        depth_scale: 1.0,
+        white_cdm2: None,
+        repair_nonfinite: false,
+    }
 }

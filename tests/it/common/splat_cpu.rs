@@ -1,6 +1,5 @@
 //! CPU implementations of each splat step, written from the specification in
 //! src/render/splat/ (not from the shaders), to check the GPU passes one by one.
-#![allow(dead_code)]
 
 use ocular::render::splat::{Fragment, MergeSettings};
 

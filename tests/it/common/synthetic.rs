@@ -2,7 +2,6 @@
 //! channel, the blur radius grows linearly with the dioptre distance from that channel's
 //! focus, and the kernel shape is a soft disc whose asymmetry varies smoothly with dioptres
 //! (so that orientation mistakes and interpolation over distance both show).
-#![allow(dead_code)]
 
 use ocular::psf::kernels::{
     level_block_radius, level_count, level_radius_px, DioptreAxis, KernelGrid, KernelSet,
