@@ -419,7 +419,7 @@ fn compare_reports_quality_and_writes_maps() {
     let report: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let method = |name: &str| method_row(&report, name);
     // At this size the blur is a pixel or two, where every method is close to the truth; the
-    // ranking under strong blur is asserted in tests/slices.rs.
+    // ranking under strong blur is asserted in slices.rs.
     let (truth, splat, slices) = (method("reference"), method("splat"), method("slices"));
     assert!(
         truth["psnr_db"].is_null(),

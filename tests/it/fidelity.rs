@@ -5,7 +5,7 @@
 //! computed from the eye's Zernike coefficients with rustfft), never against splat's own kernels
 //! or blend, and has a negative control that fails its bar. docs/validation-common-cases.md
 //! holds the figures and what each truth shares with splat.
-//! Figures: `cargo test --release --test fidelity -- --nocapture`.
+//! Figures: `cargo test --release --test it fidelity:: -- --nocapture`.
 
 use crate::common;
 

@@ -4,7 +4,7 @@
 //! its direction; the ground truth traces the eye for every field bin (no lattice, no
 //! interpolation over the field; it shares the PSF computation of a direction and the blend
 //! with splat, not the lattice). Figures:
-//! `cargo test --release --test off_axis_runtime -- --nocapture`.
+//! `cargo test --release --test it off_axis_runtime:: -- --nocapture`.
 
 use crate::common;
 

@@ -3,7 +3,7 @@
 //! infinity, planes at 0.5 m and 1 m), the splat runtime and the ground truth are compared with
 //! that convolution, computed here independently of their blend (it shares the exact kernel,
 //! not the method). The figures are the plane table of docs/validation.md:
-//! `cargo test --release --test plane_four_eyes -- --nocapture`.
+//! `cargo test --release --test it plane_four_eyes:: -- --nocapture`.
 
 use crate::common;
 
