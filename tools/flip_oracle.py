@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates tests/data/flip/: small synthetic image pairs and the FLIP maps that NVIDIA's
 reference implementation (the `flip-evaluator` package, version 1.7) computes for them, which
-tests/flip.rs holds ocular's FLIP to.
+tests/it/flip.rs holds ocular's FLIP to.
 
     python3 -m venv /tmp/flipvenv && /tmp/flipvenv/bin/pip install flip-evaluator==1.7 numpy
     /tmp/flipvenv/bin/python tools/flip_oracle.py

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Negative controls for tests/psf_true_kernels.rs: puts back (1) the old β degree cap of 60
+# Negative controls for tests/it/psf_true_kernels.rs: puts back (1) the old β degree cap of 60
 # with the ENZ series for every PSF, and (2) the old point sampling (retinal 4 µm pitch, 2
 # samples per pixel) with the old resample (each sample a unit box), runs the test for each and
 # restores the sources. Both runs must FAIL. Refuses to run over uncommitted changes in src/psf.
@@ -11,7 +11,7 @@ if ! git diff --quiet -- src/psf; then
 fi
 trap 'git checkout -- src/psf' EXIT
 run() {
-    if cargo test --release --test psf_true_kernels 2>&1 | grep -E "^test |test result"; then :; fi
+    if cargo test --release --test it psf_true_kernels:: 2>&1 | grep -E "^test |test result"; then :; fi
     git checkout -- src/psf
 }
 echo "== control 1: β degree cap 60, ENZ for every PSF"

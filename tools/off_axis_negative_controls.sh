@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Negative controls for tests/off_axis_kernels.rs: (1) the object's astigmatic defocus added
+# Negative controls for tests/it/off_axis_kernels.rs: (1) the object's astigmatic defocus added
 # with the wrong sign, (2) the disc's PSF used without resampling through the pupil stretch.
 # Runs the elliptical-pupil test for each and restores the source; both runs must FAIL.
 # Refuses to run over uncommitted changes in src/psf.
@@ -11,7 +11,7 @@ if ! git diff --quiet -- src/psf; then
 fi
 trap 'git checkout -- src/psf' EXIT
 run() {
-    if cargo test --release --test off_axis_kernels defocused -- --nocapture 2>&1 |
+    if cargo test --release --test it off_axis_kernels::defocused -- --nocapture 2>&1 |
         grep -E "σ|^test |test result"; then :; fi
     git checkout -- src/psf
 }

@@ -538,7 +538,7 @@ fn render_methods(
     }
     let splat = renderer.render(input, eye_state, Method::Splat)?;
     // The layered frame is peeled and splatted in one submission, its layers never on the
-    // host (tests/engine.rs: the same image as the layers read back and uploaded).
+    // host (tests/it/engine.rs: the same image as the layers read back and uploaded).
     let layered = if layers > 1 {
         let state = at.scene.at_time(0.0);
         let mut raster = crate::render::Rasterizer::new(at.ctx)?;

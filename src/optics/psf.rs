@@ -12,7 +12,7 @@
 //! to the pupil's x and y. With this kernel a positive tilt c(1,1) moves the spot to −x by
 //! 2c/λ (λ/NA units), and a positive coma c(3,1) puts the sharp core at +x with its flare
 //! (the comet tail) extending towards −x; c(3,−1) does the same along y (core at +y, i.e.
-//! towards row 0). Tested in tests/psf.rs.
+//! towards row 0). Tested in tests/it/optics_psf.rs.
 //!
 //! # Accuracy
 //! The β expansion misses a fraction `beta_tolerance` of the pupil energy; the field error

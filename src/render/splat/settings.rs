@@ -77,7 +77,7 @@ pub struct SplatSettings {
     pub steady_state: bool,
     /// A hidden-layer fragment lends light only through the part of the pupil that sees it
     /// past the nearer surfaces (false: wherever nearer depth groups leave coverage, as
-    /// before; kept as the control `tests/layers.rs` measures against).
+    /// before; kept as the control `tests/it/layers.rs` measures against).
     pub pupil_visibility: bool,
     /// How the convolution walks a tile's list (the same image either way).
     pub convolve_walk: ConvolveWalk,

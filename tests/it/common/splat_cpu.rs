@@ -1,0 +1,229 @@
+//! CPU implementations of each splat step, written from the specification in
+//! src/render/splat/ (not from the shaders), to check the GPU passes one by one.
+
+use ocular::render::splat::{Fragment, MergeSettings};
+
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    pub tile: u32,
+    pub dioptre_min: f32,
+    pub dioptre_step: f32,
+    pub max_radius: u32,
+    /// Focal length in pixels for the wide-field geometry; 0 = the centre's scale everywhere
+    /// and view-axis vergence.
+    pub focal_px: f32,
+    /// The blend's depth-group tolerance (D): a merged block lies within one group.
+    pub group_tolerance_d: f32,
+}
+
+impl Frame {
+    /// Distance along the ray over view-axis depth at a screen point.
+    pub fn ray_factor(&self, x: f32, y: f32) -> f32 {
+        if self.focal_px <= 0.0 {
+            return 1.0;
+        }
+        let u = (x - 0.5 * self.width as f32) / self.focal_px;
+        let v = (y - 0.5 * self.height as f32) / self.focal_px;
+        (1.0 + u * u + v * v).sqrt()
+    }
+
+    /// cos θ of the direction through a screen point (1 without the wide-field geometry).
+    pub fn cos_theta(&self, x: f32, y: f32) -> f32 {
+        if self.focal_px <= 0.0 {
+            return 1.0;
+        }
+        let u = x - 0.5 * self.width as f32;
+        let v = y - 0.5 * self.height as f32;
+        let rho = (u * u + v * v).sqrt();
+        if rho < 1e-6 {
+            return 1.0;
+        }
+        self.focal_px / (self.focal_px * self.focal_px + rho * rho).sqrt()
+    }
+}
+
+pub fn fragments(
+    frame: &Frame,
+    color: &[[f32; 4]],
+    depth: &[f32],
+    radii: &[[f32; 3]],
+) -> Vec<Fragment> {
+    let last = (radii.len() - 1) as f32;
+    (0..frame.width * frame.height)
+        .map(|i| {
+            let d = depth[i as usize];
+            let finite = d > 0.0 && d.is_finite();
+            let center = [
+                (i % frame.width) as f32 + 0.5,
+                (i / frame.width) as f32 + 0.5,
+            ];
+            // Light arrives with the vergence of the distance along the pixel's ray.
+            let distance = d * frame.ray_factor(center[0], center[1]);
+            let dioptre = if finite { 1.0 / distance } else { 0.0 };
+            let index = ((dioptre - frame.dioptre_min) / frame.dioptre_step).clamp(0.0, last);
+            let i0 = index.floor() as usize;
+            let i1 = (i0 + 1).min(radii.len() - 1);
+            let t = index - i0 as f32;
+            let radius = [0, 1, 2].map(|c| {
+                (radii[i0][c] * (1.0 - t) + radii[i1][c] * t).min(frame.max_radius as f32)
+            });
+            let c = color[i as usize];
+            Fragment {
+                color: [c[0], c[1], c[2]],
+                depth: if finite { distance } else { 3.0e38 },
+                radius,
+                index,
+                center,
+                size: 1,
+                dioptre,
+            }
+        })
+        .collect()
+}
+
+/// One merge level (block `size` 2, 4, …) following the rules in merge.comp.
+/// `core`: per object distance, the smallest core radius over the channels (merge.comp).
+pub fn merge_level(
+    frame: &Frame,
+    fragments: &mut [Fragment],
+    settings: &MergeSettings,
+    core: &[f32],
+    size: u32,
+) {
+    let core_of = |f: &Fragment| {
+        let i0 = f.index.floor() as usize;
+        let i1 = (i0 + 1).min(core.len() - 1);
+        let t = f.index - i0 as f32;
+        core[i0] * (1.0 - t) + core[i1] * t
+    };
+    let child = size / 2;
+    let w = frame.width;
+    for by in 0..frame.height / size {
+        for bx in 0..w / size {
+            let o = (by * size) * w + bx * size;
+            let ids = [o, o + child, o + child * w, o + child * w + child].map(|i| i as usize);
+            let f: Vec<Fragment> = ids.iter().map(|&i| fragments[i]).collect();
+            if f.iter().any(|x| x.size != child) {
+                continue;
+            }
+            let r_min = f
+                .iter()
+                .flat_map(|x| x.radius.into_iter().chain([core_of(x)]))
+                .fold(f32::INFINITY, f32::min);
+            if r_min
+                < settings
+                    .min_radius_px
+                    .max(settings.blur_per_block * size as f32)
+            {
+                continue;
+            }
+            let (lo, hi) = f
+                .iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), x| {
+                    (lo.min(x.dioptre), hi.max(x.dioptre))
+                });
+            if hi - lo > frame.group_tolerance_d {
+                continue;
+            }
+            // 4π·ε·(r/s)², in merge.comp's order of operations.
+            let blur_per_side = r_min / size as f32;
+            let color_bound = 12.566371f32 * settings.color_error * blur_per_side * blur_per_side;
+            let mut ok = true;
+            let mut spread = 0.0f32;
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    let dc = (0..3)
+                        .map(|c| (f[a].color[c] - f[b].color[c]).abs())
+                        .fold(0.0, f32::max);
+                    if dc > color_bound {
+                        ok = false;
+                    }
+                    spread += (f[a].index - f[b].index).abs() * frame.dioptre_step;
+                }
+            }
+            if !ok || spread >= 6.0 * settings.dioptre_tolerance * r_min {
+                continue;
+            }
+            let mut m = f[0];
+            m.color = [0, 1, 2].map(|c| 0.25 * f.iter().map(|x| x.color[c]).sum::<f32>());
+            m.depth = f.iter().map(|x| x.depth).fold(f32::INFINITY, f32::min);
+            m.index = 0.25 * f.iter().map(|x| x.index).sum::<f32>();
+            m.dioptre = 0.25 * f.iter().map(|x| x.dioptre).sum::<f32>();
+            // Every block keeps its children's kernel: a 2×2 block reads it half a pixel off the
+            // grid (the bilinear lookup sums it over the four pixels), a larger one reads its
+            // block-summed kernel.
+            m.radius = [0, 1, 2].map(|c| f.iter().map(|x| x.radius[c]).fold(0.0, f32::max));
+            m.center = [
+                (bx * size) as f32 + 0.5 * size as f32,
+                (by * size) as f32 + 0.5 * size as f32,
+            ];
+            m.size = size;
+            fragments[ids[0]] = m;
+            for &i in &ids[1..] {
+                fragments[i].size = 0;
+            }
+        }
+    }
+}
+
+/// Inclusive pixel rectangle a fragment's kernel can reach (square support).
+pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
+    let radius = f.radius.iter().fold(0.0f32, |a, &b| a.max(b));
+    let mut r = radius.ceil();
+    // Off the centre of a wide frame a kernel of radius ≥ 0.5 px stretches radially by up to
+    // 1/cos²θ (in full from 1.5 px), read bilinearly.
+    let c = frame.cos_theta(f.center[0], f.center[1]);
+    let t = (radius - 0.5).clamp(0.0, 1.0);
+    let (cr, ct) = (1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0));
+    // The extent of the square |k| < r + 1 under the inverse map along the screen axes.
+    let mut stretch = 1.0;
+    if cr < 1.0 {
+        let u = f.center[0] - 0.5 * frame.width as f32;
+        let v = f.center[1] - 0.5 * frame.height as f32;
+        let rho = (u * u + v * v).sqrt();
+        let (ex, ey) = (u / rho, v / rho);
+        let a = 1.0 / cr - 1.0 / ct;
+        let along = (ex * ex).max(ey * ey) + (ex * ey).abs();
+        stretch = 1.0 / ct + a * along;
+        r = ((r + 1.0) * stretch).ceil() - 1.0;
+    }
+    let reach = if f.size >= 4 {
+        // a block-summed kernel: (2r + s)² texels, non-zero within r + s/2 + ½
+        ((radius.ceil() + 0.5 * f.size as f32 + 0.5) * stretch - 0.5).ceil() - 0.5
+    } else if f.size > 1 {
+        r + 0.5
+    } else {
+        r
+    };
+    let x0 = ((f.center[0] - 0.5 - reach).ceil() as i64).max(0);
+    let y0 = ((f.center[1] - 0.5 - reach).ceil() as i64).max(0);
+    let x1 = ((f.center[0] - 0.5 + reach).floor() as i64).min(frame.width as i64 - 1);
+    let y1 = ((f.center[1] - 0.5 + reach).floor() as i64).min(frame.height as i64 - 1);
+    (x0 <= x1 && y0 <= y1).then_some([x0, y0, x1, y1])
+}
+
+/// Per tile, the sorted (depth bits, fragment index) list.
+pub fn tile_lists(frame: &Frame, fragments: &[Fragment]) -> Vec<Vec<[u32; 2]>> {
+    let t = frame.tile as i64;
+    let tiles_x = frame.width.div_ceil(frame.tile) as usize;
+    let tiles_y = frame.height.div_ceil(frame.tile) as usize;
+    let mut lists = vec![Vec::new(); tiles_x * tiles_y];
+    for (i, f) in fragments.iter().enumerate() {
+        if f.size == 0 {
+            continue;
+        }
+        if let Some([x0, y0, x1, y1]) = reach_rect(frame, f) {
+            for ty in y0 / t..=y1 / t {
+                for tx in x0 / t..=x1 / t {
+                    lists[ty as usize * tiles_x + tx as usize]
+                        .push([f.depth.max(0.0).to_bits(), i as u32]);
+                }
+            }
+        }
+    }
+    for list in &mut lists {
+        list.sort_unstable();
+    }
+    lists
+}

@@ -1,0 +1,64 @@
+//! The integration tests: one crate, so one binary to link and run (the layout nalgebra uses).
+//! Each module is one subject, as its file's first lines say; `common` holds the helpers they
+//! share. Run one subject with `cargo test --release --test it SUBJECT::` (ci/test.sh runs all).
+
+mod common;
+
+mod aberration_files;
+mod blend;
+mod cli_basics;
+mod cli_corrections;
+mod cli_eye;
+mod cli_frontdoors;
+mod cli_help;
+mod cli_kernels;
+mod cli_metrics;
+mod cli_off_axis;
+mod cli_outputs;
+mod cli_psf;
+mod cli_ranges;
+mod cli_raster;
+mod cli_real_inputs;
+mod cli_video_trust;
+mod corrections;
+mod engine;
+mod engine_layers;
+mod exr_bytes;
+mod eye_behaviour;
+mod eye_estimate;
+mod eye_navarro;
+mod eye_robustness;
+mod fidelity;
+mod flip;
+mod gpu_layer;
+mod image_io;
+mod layered_inputs;
+mod layers;
+mod metrics;
+mod metrics_small;
+mod off_axis_kernels;
+mod off_axis_optics;
+mod off_axis_runtime;
+mod optics_bessel;
+mod optics_beta;
+mod optics_enz_vnm;
+mod optics_errors_extremes;
+mod optics_psf;
+mod optics_zernike;
+mod plane_four_eyes;
+mod psf_cache;
+mod psf_grid;
+mod psf_true_kernels;
+mod radius_levels;
+mod raster;
+mod raster_hdr;
+mod real_inputs;
+mod rx_convention;
+mod scene;
+mod scenes_small;
+mod slices;
+mod splat;
+mod splat_presets;
+mod splat_real_kernels;
+mod views;
+mod wide_field;
