@@ -185,8 +185,8 @@ pub struct SplatArgs {
     )]
     pub merge_min_radius: f32,
     /// The most that averaging one merged block's colours may change any pixel, block by block
-    /// (linear colour units; default 1/255; with blocks larger than 2×2 use 1/1020, since the
-    /// blocks along a kernel's rim add). A block of side s under blur radius r merges when its parts'
+    /// (linear colour units; default 1/1020, a quarter of an 8-bit step, since the blocks along
+    /// a kernel's rim add). A block of side s under blur radius r merges when its parts'
     /// colours differ by at most 4π·E·(r/s)²: the wider the blur against the block, the
     /// larger the difference that cannot show.
     #[arg(

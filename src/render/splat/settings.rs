@@ -31,17 +31,17 @@ pub struct MergeSettings {
 }
 
 impl MergeSettings {
-    /// 2×2 blocks only. Up to 32×32 with ε = 1/1020 keeps the textured plane and the 640×360
-    /// references, but costs colonnade/astigmatism 2.5 dB at 1280×720 (docs/validation.md,
-    /// "Merging"): a setting, not the default.
-    pub const DEFAULT_LEVELS: u32 = 1;
-    pub const DEFAULT_BLUR_PER_BLOCK: f32 = 1.0;
-    /// One 8-bit step, for the default 2×2 blocks, where it changes no measured figure. The
-    /// bound holds per block, and the blocks along a kernel's rim add: on a texture whose
-    /// period is near the block side they all meet it (a sinusoid plane under a 12–19 px blur,
-    /// merged up to 32×32, loses 2–12 dB at 1/255, 24 dB at 1/16 and nothing at 1/1020;
-    /// docs/validation.md, "Merging").
-    pub const DEFAULT_COLOR_ERROR: f32 = 1.0 / 255.0;
+    /// Blocks up to 32×32 where colours allow (docs/validation.md, "Merging").
+    pub const DEFAULT_LEVELS: u32 = 5;
+    /// No block wider than half the blur: with blocks as wide as the blur (k = 1),
+    /// colonnade/astigmatism at 1280×720 lost 2.5 dB against 2×2 blocks; with k = 2 it gains
+    /// 1.2 dB.
+    pub const DEFAULT_BLUR_PER_BLOCK: f32 = 2.0;
+    /// A quarter of an 8-bit step. The bound holds per block, and the blocks along a kernel's
+    /// rim add: on a texture whose period is near the block side they all meet it (a sinusoid
+    /// plane under a 12–19 px blur, merged up to 32×32, loses 2–12 dB at 1/255, 24 dB at 1/16
+    /// and nothing at 1/1020; docs/validation.md, "Merging").
+    pub const DEFAULT_COLOR_ERROR: f32 = 1.0 / 1020.0;
 }
 
 impl Default for MergeSettings {
