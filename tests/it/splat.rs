@@ -594,8 +594,11 @@ fn every_pass_matches_its_cpu_step() {
     let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
     let grid = eye.grid(objects, max_radius, &[4.0], 90);
     let scene = merging_scene();
+    // Blocks as wide as the blur (k = 1), so that this small blur makes 4×4 blocks.
     let merge = MergeSettings {
         levels: 2,
+        blur_per_block: 1.0,
+        color_error: 1.0 / 255.0,
         ..MergeSettings::default()
     };
     let settings = SplatSettings {
@@ -789,8 +792,11 @@ fn fragments_split_over_four_bindings_render_the_same() {
     let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
     let grid = eye.grid(objects, max_radius, &[4.0], 90);
     let scene = merging_scene();
+    // Blocks as wide as the blur (k = 1), so that this small blur makes 4×4 blocks.
     let merge = MergeSettings {
         levels: 2,
+        blur_per_block: 1.0,
+        color_error: 1.0 / 255.0,
         ..MergeSettings::default()
     };
     let whole = SplatSettings {

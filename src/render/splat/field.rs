@@ -429,10 +429,11 @@ mod tests {
         let b = block_kernels(&seed, 11);
         assert_eq!(b.iter().map(|b| b.side).collect::<Vec<_>>(), [4, 8]);
         assert!(b.iter().all(|b| level_radius_px(b.first_level) == 4.0));
-        // All five levels at the default k = 1: every side up to 32, each from the radius of
-        // its own side (and the 5 px minimum).
+        // All five levels at k = 1: every side up to 32, each from the radius of its own side
+        // (and the 5 px minimum).
         let all = crate::render::splat::MergeSettings {
             levels: 5,
+            blur_per_block: 1.0,
             ..Default::default()
         };
         let b = block_kernels(&all, 40);
@@ -441,8 +442,18 @@ mod tests {
             .map(|b| (b.side, level_radius_px(b.first_level)))
             .collect();
         assert_eq!(starts, [(4, 4.0), (8, 7.0), (16, 15.0), (32, 31.0)]);
-        // The default merges 2×2 blocks only: no block kernels.
-        assert!(block_kernels(&crate::render::splat::MergeSettings::default(), 40).is_empty());
+        // 2×2 blocks only need no block kernels; the default (k = 2) stores the sides whose
+        // kernels fit under Rmax 40: 4, 8 and 16 (a 32×32 block needs 64 px).
+        let two_by_two = crate::render::splat::MergeSettings {
+            levels: 1,
+            ..Default::default()
+        };
+        assert!(block_kernels(&two_by_two, 40).is_empty());
+        let sides: Vec<u32> = block_kernels(&crate::render::splat::MergeSettings::default(), 40)
+            .iter()
+            .map(|b| b.side)
+            .collect();
+        assert_eq!(sides, [4, 8, 16]);
     }
 
     /// The atlas against the equal-layer layout it replaced, (2·Rmax + 1 + 2)² texels per
