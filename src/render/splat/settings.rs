@@ -46,7 +46,8 @@ impl MergeSettings {
 
 impl Default for MergeSettings {
     fn default() -> Self {
-        // The seed paper's framework defaults; with more levels, no block wider than the blur.
+        // The minimum radius and dioptre tolerance are the seed paper's; the levels, the block
+        // width and the colour bound are this engine's (see their constants).
         MergeSettings {
             levels: MergeSettings::DEFAULT_LEVELS,
             blur_per_block: MergeSettings::DEFAULT_BLUR_PER_BLOCK,
