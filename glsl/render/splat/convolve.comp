@@ -52,17 +52,6 @@ shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shri
 shared Fragment batch[64];
 shared uvec4 batch_nodes[64];  // off axis: the four field nodes around the fragment
 shared vec4 batch_node_weights[64];
-// The usual fragment's reads, planned once per batch instead of once per pixel (depth groups,
-// channels within three consecutive radius levels): per read i of level base + i, its
-// kernel's offset 0 in texels (slot_point), its bound (0: not read) and the red coefficient;
-// then the green and blue coefficients of reads 0 and 1, of read 2, the texture layer
-// coordinate and 1 where the plan applies. Each coefficient folds the radius mix, the level's
-// (2r+1)² storage scale, the local scale's weight and a merged block's pixel count, so a pixel
-// makes only the filtered reads and three multiply-adds. (Measured on an H200: the per-pixel
-// level arithmetic and atlas look-ups, not the texture reads, bounded this pass.)
-shared vec4 batch_read[64 * 3];
-shared vec4 batch_gb[64 * 2];
-shared vec4 batch_origins[64 * 2]; // off axis: the four field nodes' region origins (texels)
 shared uint unsaturated;       // threads with a pixel whose closed groups cover < 1 − ε
 
 // RGB kernel values at radius level l (divided by the (2r+1)² storage scale of its block) of
@@ -142,59 +131,6 @@ vec3 fragment_weight(uint j, Fragment f, vec2 d) {
     return w;
 }
 
-// Plans fragment f's reads into batch slot j (batch_read, batch_gb); `pre` multiplies every
-// coefficient. Returns false, planning nothing, where its channels span more than three radius
-// levels: fragment_weight serves it.
-bool plan_reads(uint j, Fragment f, float pre) {
-    vec3 level = level_of_radius(f.radius);
-    vec3 lo = floor(level);
-    vec3 t = level - lo;
-    float base = min(lo.r, min(lo.g, lo.b));
-    float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
-    if (top - base > 2.0) {
-        return false;
-    }
-    // Channel c takes (1 − t) of read i0 = lo − base and t of read i0 + 1.
-    vec3 i0 = lo - base;
-    vec3 first = step(0.5, i0);
-    vec3 second = step(1.5, i0);
-    vec3 coef[3];
-    coef[0] = (1.0 - t) * (1.0 - first);
-    coef[1] = (1.0 - t) * (first - second) + t * (1.0 - first);
-    coef[2] = (1.0 - t) * second + t * (first - second);
-    uint size = block_size(f);
-    [[unroll]] for (uint i = 0u; i < 3u; i++) {
-        uint l = uint(base) + i;
-        // Past the largest level the kernel is zero; a read no channel takes is not made.
-        bool used = l < level_count() && any(greaterThan(coef[i], vec3(0.0)));
-        uint at = used ? kernel_slot(l, size) : 0u;
-        float k = float(2u * level_block_radius(l) + 1u);
-        coef[i] *= pre / (k * k);
-        batch_read[3u * j + i] = vec4(slot_point(at), used ? slot_bound(at, l) : 0.0, coef[i].r);
-    }
-    batch_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
-    batch_gb[2u * j + 1u].xy = coef[2].gb;
-    return true;
-}
-
-// Read i of batch slot j at kernel offset d in the region whose origin is `node`, times its
-// coefficients.
-vec3 planned_read(uint j, uint i, vec2 coef_gb, vec2 node, vec2 d, float layer, vec2 extent) {
-    vec4 at = batch_read[3u * j + i];
-    if (any(greaterThanEqual(abs(d), vec2(at.z)))) {
-        return vec3(0.0);
-    }
-    vec3 c = vec3(at.w, coef_gb);
-    return c * textureLod(psf_texture, vec3((node + at.xy + d) / extent, layer), 0.0).rgb;
-}
-
-// The planned weight of batch slot j at kernel offset d in the region whose origin is `node`.
-vec3 planned_weight(uint j, vec2 node, vec2 d, vec4 gb0, vec4 gb1, vec2 extent) {
-    return planned_read(j, 0u, gb0.xy, node, d, gb1.z, extent)
-         + planned_read(j, 1u, gb0.zw, node, d, gb1.z, extent)
-         + planned_read(j, 2u, gb1.xy, node, d, gb1.z, extent);
-}
-
 #include "blend.glsl"
 
 void main() {
@@ -230,7 +166,6 @@ void main() {
         last[q] = -1.0;
     }
     bool grouped = frame.blend_mode == 0u;
-    vec3 extent = vec3(textureSize(psf_texture, 0));
 
     for (uint start = 0u; start < n; start += 64u) {
         if (local_index == 0u) {
@@ -245,10 +180,6 @@ void main() {
                 field_corners(f.center, nodes, weights);
                 batch_nodes[local_index] = nodes;
                 batch_node_weights[local_index] = weights;
-                batch_origins[2u * local_index] =
-                    vec4(vec2(node_origin(nodes.x)), vec2(node_origin(nodes.y)));
-                batch_origins[2u * local_index + 1u] =
-                    vec4(vec2(node_origin(nodes.z)), vec2(node_origin(nodes.w)));
             }
             vec3 s = local_scale(f.center);
             // The largest channel radius decides how much of the local scale applies.
@@ -256,10 +187,6 @@ void main() {
             vec2 c = shrink_for_radius(s.z, r);
             batch_reach[local_index] = vec4(f.center, fragment_reach(f), c.x < 1.0 ? 1.0 : 0.0);
             batch_scale[local_index] = vec4(s.xy, c);
-            uint size = block_size(f);
-            float pre = (size > 1u ? float(size * size) : 1.0) * (c.x < 1.0 ? c.x * c.y : 1.0);
-            bool planned = grouped && plan_reads(local_index, f, pre);
-            batch_gb[2u * local_index + 1u].zw = vec2((f.index + 0.5) / extent.z, planned ? 1.0 : 0.0);
         }
         barrier();
         uint batch_size = min(64u, n - start);
@@ -272,28 +199,7 @@ void main() {
                 }
                 Fragment f = batch[j];
                 vec3 w;
-                vec4 gb1 = batch_gb[2u * j + 1u];
-                if (gb1.w > 0.5) {
-                    vec2 k = d;
-                    if (g.w > 0.5) {
-                        vec4 s = batch_scale[j];
-                        k = kernel_offset(s.xy, s.zw, d);
-                    }
-                    vec4 gb0 = batch_gb[2u * j];
-                    if (OFF_AXIS == 0u) {
-                        w = planned_weight(j, vec2(0.0), k, gb0, gb1, extent.xy);
-                    } else {
-                        // The four field nodes' kernels, mixed bilinearly in field angle.
-                        vec4 nw = batch_node_weights[j];
-                        vec4 o01 = batch_origins[2u * j];
-                        vec4 o23 = batch_origins[2u * j + 1u];
-                        w = vec3(0.0);
-                        if (nw.x > 0.0) w += nw.x * planned_weight(j, o01.xy, k, gb0, gb1, extent.xy);
-                        if (nw.y > 0.0) w += nw.y * planned_weight(j, o01.zw, k, gb0, gb1, extent.xy);
-                        if (nw.z > 0.0) w += nw.z * planned_weight(j, o23.xy, k, gb0, gb1, extent.xy);
-                        if (nw.w > 0.0) w += nw.w * planned_weight(j, o23.zw, k, gb0, gb1, extent.xy);
-                    }
-                } else if (g.w > 0.5) {
+                if (g.w > 0.5) {
                     vec4 s = batch_scale[j];
                     w = fragment_weight(j, f, kernel_offset(s.xy, s.zw, d)) * (s.z * s.w);
                 } else {
