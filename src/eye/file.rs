@@ -3,8 +3,9 @@
 //! TOML. A bare structure without the `[eye]` wrapper is read as well. Named eyes (presets)
 //! resolve before files, so `ocular eye show myopia` needs no path.
 
+use super::error::EyeError;
 use super::estimate::Report;
-use super::model::{Eye, EyeError};
+use super::model::Eye;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

@@ -1,10 +1,11 @@
 //! Named eyes: Navarro's schematic eye in the parametric form, the population mean of the seed
 //! paper's Table 1, and Navarro's own accommodating eye (as an optical system).
 
+use super::error::EyeError;
 use super::lens::diameter_volume_from_radii;
 use super::media::Medium;
 use super::model::{
-    Cornea, CornealSurface, Eye, EyeError, Lens, Retina, DEFAULT_ELEVATION_RADIUS_MM,
+    Cornea, CornealSurface, Eye, Lens, Retina, DEFAULT_ELEVATION_RADIUS_MM,
     WIDE_ANGLE_RETINA_RADIUS_MM,
 };
 use super::surface::Surface;

@@ -20,7 +20,8 @@ pub mod pattern_search;
 pub mod prescription;
 
 use crate::aberrations::ZernikeSet;
-use crate::eye::model::{Eye, EyeError};
+use crate::eye::error::EyeError;
+use crate::eye::model::Eye;
 use crate::optics::zernike::{num_terms, osa_index, osa_nm};
 use least_squares::{levenberg_marquardt, LmSettings};
 use loss::{Evaluator, Objective, ORDER_WEIGHTS};
