@@ -63,6 +63,16 @@ pub fn preset(name: &str) -> Option<EyeFile> {
         .map(|e| parse(e.1).expect("shipped eye presets are valid"))
 }
 
+// Here rather than with the built-in presets: the estimated eyes are files, and this module
+// already reads both kinds.
+impl Eye {
+    /// A preset by name: `navarro`, `navarro-wide`, `mean`, or one of the estimated eyes (`healthy`,
+    /// `myopia`, `astigmatism`, `keratoconus`; see `eye::file`).
+    pub fn preset(name: &str) -> Option<Eye> {
+        super::presets::builtin_preset(name).or_else(|| preset(name).map(|f| f.eye))
+    }
+}
+
 /// Parses an eye file's text.
 pub fn parse(text: &str) -> Result<EyeFile, EyeError> {
     let eye = Eye::from_toml_str(text)?;

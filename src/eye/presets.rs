@@ -106,12 +106,6 @@ impl Eye {
             retina: Retina::default(),
         }
     }
-
-    /// A preset by name: `navarro`, `navarro-wide`, `mean`, or one of the estimated eyes (`healthy`,
-    /// `myopia`, `astigmatism`, `keratoconus`; see `eye::file`).
-    pub fn preset(name: &str) -> Option<Eye> {
-        builtin_preset(name).or_else(|| super::file::preset(name).map(|f| f.eye))
-    }
 }
 
 /// The presets defined in code (no estimate record).
