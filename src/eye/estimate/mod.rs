@@ -31,8 +31,6 @@ use serde::Serialize;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-pub use prescription::RxTarget;
-
 /// The hybrid's polish ends when this many pattern-search iterations together gain less
 /// than this fraction of the loss. Where the input is not exactly reachable (keratoconus:
 /// measured tilt terms that a chief-ray-referenced wavefront cannot carry together with its
