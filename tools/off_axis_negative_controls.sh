@@ -25,9 +25,9 @@ open(path, 'w').write(s.replace(old, new))
 PY
 }
 echo "== control 1: the object's astigmatism with the wrong sign"
-sub src/psf/field.rs 'alpha[osa_index(2, 2)] += c22;' 'alpha[osa_index(2, 2)] -= c22;'
+sub src/psf/field_psf.rs 'alpha[osa_index(2, 2)] += c22;' 'alpha[osa_index(2, 2)] -= c22;'
 run
 echo "== control 2: no resampling through the stretch"
-sub src/psf/field.rs '*v = sample(s[0][0] * x + s[0][1] * y, s[1][0] * x + s[1][1] * y) * det;' \
+sub src/psf/field_psf.rs '*v = sample(s[0][0] * x + s[0][1] * y, s[1][0] * x + s[1][1] * y) * det;' \
     '*v = sample(x, y) * det;'
 run

@@ -10,7 +10,8 @@ use std::sync::Arc;
 use super::outputs::Outputs;
 use super::write_atomic;
 use crate::aberrations::{self, ZernikeSet};
-use crate::eye::estimate::{self, Estimate, Method, Progress, RxTarget, Settings};
+use crate::eye::estimate::prescription::RxTarget;
+use crate::eye::estimate::{self, Estimate, Method, Progress, Settings};
 use crate::eye::{self, file as eye_file};
 use crate::{Error, Result};
 

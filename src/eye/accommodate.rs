@@ -7,8 +7,9 @@
 //! smoothly and monotonically with the diameter, so a safeguarded secant converges in a few
 //! steps, each a cheap 96-ray order-4 measurement.
 
+use super::error::EyeError;
 use super::measure::Measurer;
-use super::model::{Eye, EyeError};
+use super::model::Eye;
 use crate::optics::zernike::osa_index;
 use std::sync::OnceLock;
 

@@ -15,8 +15,11 @@
 //! meridian and S + C across it. The vertex distance is from the lens to the corneal vertex;
 //! 0 is a contact lens. The lens's own chromatic aberration is left out (P/V: 0.09 D for a
 //! 5 D CR-39 lens).
+//!
+//! The model holds these lenses, so this module stays below it: what needs an eye (where an
+//! IOL sits, the IOL power or spectacle an eye needs) is in `model` and `refract`.
 
-use super::model::{Eye, EyeError};
+use super::error::EyeError;
 use super::surface::Surface;
 use crate::optics::zernike::Prescription;
 use serde::{Deserialize, Serialize};
@@ -227,55 +230,9 @@ impl Iol {
         in_range("iol.power_d", self.power_d, IOL_RANGE_D, "D")
     }
 
-    /// Where the IOL sits: the crystalline lens's equator plane (the capsular bag holds the
-    /// optic there), in mm from the corneal vertex; the iris stays where it was.
-    pub fn plane_z_mm(eye: &Eye) -> Result<f64, EyeError> {
-        eye.lens_equator_z_mm()
-    }
-
     pub fn surface(&self, z_mm: f64) -> Surface {
         Surface::ideal_lens(z_mm, [self.power_d; 2], 0.0)
     }
-}
-
-/// The IOL power (D) that leaves `eye` (its cornea, axial length and IOL plane; any
-/// spectacle removed) without Zernike defocus for a distant object over a `pupil_mm` pupil at
-/// `wavelength_nm`: the traced counterpart of the thin-lens vergence formula (Fyodorov,
-/// Binkhorst) with this eye's own effective lens position.
-pub fn emmetropic_iol_power_d(
-    eye: &Eye,
-    pupil_mm: f64,
-    wavelength_nm: f64,
-) -> Result<f64, EyeError> {
-    let mut bare = eye.clone();
-    bare.correction = None;
-    let meas = super::measure::Measurer::new(4, 6, 16);
-    let j20 = crate::optics::zernike::osa_index(2, 0);
-    let mut buf = [0.0; 15];
-    let mut c20 = |p: f64| -> Result<f64, EyeError> {
-        bare.iol = Some(Iol { power_d: p });
-        let sys = bare.system()?;
-        meas.coefficients_um(&sys, wavelength_nm, pupil_mm, None, &mut buf)?;
-        Ok(buf[j20])
-    };
-    let (mut p0, mut p1) = (20.0, 22.0);
-    let (mut g0, mut g1) = (c20(p0)?, c20(p1)?);
-    for _ in 0..40 {
-        if g1.abs() < 1e-7 || g1 == g0 {
-            break;
-        }
-        let p2 = (p1 - g1 * (p1 - p0) / (g1 - g0)).clamp(IOL_RANGE_D.0, IOL_RANGE_D.1);
-        (p0, g0) = (p1, g1);
-        p1 = p2;
-        g1 = c20(p1)?;
-    }
-    if g1.abs() > 1e-4 {
-        return Err(EyeError::Invalid(format!(
-            "no IOL power within {} to {} D makes this eye emmetropic",
-            IOL_RANGE_D.0, IOL_RANGE_D.1
-        )));
-    }
-    Ok(p1)
 }
 
 #[cfg(test)]

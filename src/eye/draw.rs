@@ -2,7 +2,8 @@
 //! Figure 4 is the model): one panel per focus distance, the eye accommodated to it.
 
 use super::accommodate::accommodate;
-use super::model::{Eye, EyeError};
+use super::error::EyeError;
+use super::model::Eye;
 use super::paraxial::paraxial;
 use super::system::OpticalSystem;
 use super::trace::{trace_path, Ray};

@@ -29,11 +29,11 @@
 //! iris centre) intersection with the retina, whatever its shape, so defocus is relative to
 //! the retina at that eccentricity: peripheral refraction.
 
+use super::error::EyeError;
 use super::measure::{
     check_inputs, dist, measure, path_to_sphere, rho2_coefficient, truncate, Measurement, Measurer,
     Refraction,
 };
-use super::model::EyeError;
 use super::paraxial::paraxial;
 use super::surface::{dot, V3};
 use super::system::{OpticalSystem, MAX_SURFACES};

@@ -3,8 +3,9 @@
 //! TOML. A bare structure without the `[eye]` wrapper is read as well. Named eyes (presets)
 //! resolve before files, so `ocular eye show myopia` needs no path.
 
+use super::error::EyeError;
 use super::estimate::Report;
-use super::model::{Eye, EyeError};
+use super::model::Eye;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -60,6 +61,16 @@ pub fn preset(name: &str) -> Option<EyeFile> {
         .iter()
         .find(|e| e.0 == key)
         .map(|e| parse(e.1).expect("shipped eye presets are valid"))
+}
+
+// Here rather than with the built-in presets: the estimated eyes are files, and this module
+// already reads both kinds.
+impl Eye {
+    /// A preset by name: `navarro`, `navarro-wide`, `mean`, or one of the estimated eyes (`healthy`,
+    /// `myopia`, `astigmatism`, `keratoconus`; see `eye::file`).
+    pub fn preset(name: &str) -> Option<Eye> {
+        super::presets::builtin_preset(name).or_else(|| preset(name).map(|f| f.eye))
+    }
 }
 
 /// Parses an eye file's text.

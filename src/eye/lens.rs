@@ -5,7 +5,7 @@
 //! in t_P; its smallest positive root gives both heights, and each radius then follows from the
 //! conic passing through the equator point: a² = 2Rt − (1+k)t².
 
-use super::model::EyeError;
+use super::error::EyeError;
 use std::f64::consts::PI;
 
 /// Anterior / posterior cap-height ratio. Chosen so that Navarro's relaxed surfaces

@@ -13,8 +13,8 @@
 //! slightly elliptical, which is reported (per-meridian magnification and the iris diameter the
 //! disc needs) rather than folded into the fit.
 
+use super::error::EyeError;
 use super::fit::PupilPattern;
-use super::model::EyeError;
 use super::paraxial::{paraxial, Paraxial};
 use super::surface::{dot, V3};
 use super::system::OpticalSystem;

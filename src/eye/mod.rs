@@ -5,6 +5,7 @@ pub mod accommodate;
 pub mod age;
 pub mod correction;
 pub mod draw;
+pub mod error;
 pub mod estimate;
 pub mod field;
 pub mod file;
@@ -23,8 +24,9 @@ pub mod test_eyes;
 pub mod trace;
 
 pub use accommodate::{accommodate, focus_within_range, Accommodation, FocusLimit, Focused};
+pub use error::EyeError;
 pub use measure::{measure, Measurement, Measurer, Refraction};
-pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, EyeError, Lens, Retina};
+pub use model::{Cornea, CornealSurface, ElevationTerm, Eye, Lens, Retina};
 pub use paraxial::{paraxial, Paraxial};
 pub use presets::navarro_accommodated;
 pub use system::OpticalSystem;

@@ -5,27 +5,13 @@
 //! posterior cornea and carries the iris.
 
 use super::correction::{Iol, Spectacle};
+use super::error::EyeError;
 use super::lens::{lens_geometry, LensGeometry};
 use super::media::Medium;
 use super::surface::Surface;
 use super::system::OpticalSystem;
 use crate::optics::zernike::{is_valid_nm, num_terms, osa_index};
 use serde::{Deserialize, Serialize};
-
-/// Why an eye cannot be built.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum EyeError {
-    #[error("{name} must be finite, got {value}")]
-    NonFinite { name: &'static str, value: f64 },
-    #[error("lens cannot close: a volume of {volume_mm3:.2} mm³ exceeds the {max_volume_mm3:.2} mm³ two caps of diameter {diameter_mm} mm can hold")]
-    LensCannotClose {
-        volume_mm3: f64,
-        diameter_mm: f64,
-        max_volume_mm3: f64,
-    },
-    #[error("{0}")]
-    Invalid(String),
-}
 
 /// One Zernike elevation term of a corneal surface.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -454,6 +440,15 @@ impl Eye {
             )));
         }
         Ok(e)
+    }
+}
+
+// With the model rather than with the lens: where an IOL sits is a fact of the eye it is put in.
+impl Iol {
+    /// Where the IOL sits: the crystalline lens's equator plane (the capsular bag holds the
+    /// optic there), in mm from the corneal vertex; the iris stays where it was.
+    pub fn plane_z_mm(eye: &Eye) -> Result<f64, EyeError> {
+        eye.lens_equator_z_mm()
     }
 }
 

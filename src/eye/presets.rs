@@ -1,10 +1,11 @@
 //! Named eyes: Navarro's schematic eye in the parametric form, the population mean of the seed
 //! paper's Table 1, and Navarro's own accommodating eye (as an optical system).
 
+use super::error::EyeError;
 use super::lens::diameter_volume_from_radii;
 use super::media::Medium;
 use super::model::{
-    Cornea, CornealSurface, Eye, EyeError, Lens, Retina, DEFAULT_ELEVATION_RADIUS_MM,
+    Cornea, CornealSurface, Eye, Lens, Retina, DEFAULT_ELEVATION_RADIUS_MM,
     WIDE_ANGLE_RETINA_RADIUS_MM,
 };
 use super::surface::Surface;
@@ -104,12 +105,6 @@ impl Eye {
             iol: None,
             retina: Retina::default(),
         }
-    }
-
-    /// A preset by name: `navarro`, `navarro-wide`, `mean`, or one of the estimated eyes (`healthy`,
-    /// `myopia`, `astigmatism`, `keratoconus`; see `eye::file`).
-    pub fn preset(name: &str) -> Option<Eye> {
-        builtin_preset(name).or_else(|| super::file::preset(name).map(|f| f.eye))
     }
 }
 

@@ -8,10 +8,15 @@
 //! pupil); then the lens is refined by measuring through it (the lens changes the entrance
 //! pupil and how the eye's higher-order aberrations enter the second-order terms) until the
 //! residual is below 1e-4 D.
+//!
+//! The IOL that leaves an eye emmetropic (`emmetropic_iol_power_d`) is the same question for a
+//! lens inside the eye, so it lives here too, above the lens types of `correction` and the
+//! measurement both.
 
-use super::correction::{normalised_axis_deg, Spectacle};
+use super::correction::{normalised_axis_deg, Iol, Spectacle, IOL_RANGE_D};
+use super::error::EyeError;
 use super::measure::{Measurer, Refraction};
-use super::model::{Eye, EyeError};
+use super::model::Eye;
 use serde::Serialize;
 
 /// A prescription at the spectacle plane, and how well it corrects.
@@ -155,6 +160,46 @@ pub fn refract(
         residual_d: residual,
         iterations,
     })
+}
+
+/// The IOL power (D) that leaves `eye` (its cornea, axial length and IOL plane; any
+/// spectacle removed) without Zernike defocus for a distant object over a `pupil_mm` pupil at
+/// `wavelength_nm`: the traced counterpart of the thin-lens vergence formula (Fyodorov,
+/// Binkhorst) with this eye's own effective lens position.
+pub fn emmetropic_iol_power_d(
+    eye: &Eye,
+    pupil_mm: f64,
+    wavelength_nm: f64,
+) -> Result<f64, EyeError> {
+    let mut bare = eye.clone();
+    bare.correction = None;
+    let meas = Measurer::new(4, 6, 16);
+    let j20 = crate::optics::zernike::osa_index(2, 0);
+    let mut buf = [0.0; 15];
+    let mut c20 = |p: f64| -> Result<f64, EyeError> {
+        bare.iol = Some(Iol { power_d: p });
+        let sys = bare.system()?;
+        meas.coefficients_um(&sys, wavelength_nm, pupil_mm, None, &mut buf)?;
+        Ok(buf[j20])
+    };
+    let (mut p0, mut p1) = (20.0, 22.0);
+    let (mut g0, mut g1) = (c20(p0)?, c20(p1)?);
+    for _ in 0..40 {
+        if g1.abs() < 1e-7 || g1 == g0 {
+            break;
+        }
+        let p2 = (p1 - g1 * (p1 - p0) / (g1 - g0)).clamp(IOL_RANGE_D.0, IOL_RANGE_D.1);
+        (p0, g0) = (p1, g1);
+        p1 = p2;
+        g1 = c20(p1)?;
+    }
+    if g1.abs() > 1e-4 {
+        return Err(EyeError::Invalid(format!(
+            "no IOL power within {} to {} D makes this eye emmetropic",
+            IOL_RANGE_D.0, IOL_RANGE_D.1
+        )));
+    }
+    Ok(p1)
 }
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
 //! Plain-text description of an eye: its structure and derived optics (for `ocular eye show`).
 
+use super::error::EyeError;
 use super::measure::measure;
-use super::model::{Eye, EyeError};
+use super::model::Eye;
 use super::paraxial::paraxial;
 use std::fmt::Write;
 

@@ -1,8 +1,7 @@
 //! A traceable optical system: surfaces in order, the medium after each, the stop and retina.
 
 use super::media::{indices, Medium};
-use super::surface::{dot, Surface, V3};
-use super::trace::Ray;
+use super::surface::Surface;
 
 /// Most surfaces a system may have (fixed-size index tables keep the tracer allocation-free).
 pub const MAX_SURFACES: usize = 7;
@@ -34,23 +33,6 @@ impl OpticalSystem {
             n[i + 1] = table[*m as usize];
         }
         n
-    }
-
-    /// Where a ray (already in the vitreous, travelling towards +z) meets the retina; `None`
-    /// when it misses a spherical retina.
-    pub fn retina_hit(&self, ray: &Ray) -> Option<V3> {
-        let r = self.retina_radius_mm;
-        if !r.is_finite() {
-            return Some(ray.at(ray.to_plane(self.retina_z_mm)));
-        }
-        let q = [ray.p[0], ray.p[1], ray.p[2] - (self.retina_z_mm - r)];
-        let b = dot(ray.d, q);
-        let disc = b * b - (dot(q, q) - r * r);
-        if disc < 0.0 {
-            return None;
-        }
-        // The far intersection: the back wall of the globe, which the light reaches.
-        Some(ray.at(-b + disc.sqrt()))
     }
 
     /// Index of the medium in front of the retina.

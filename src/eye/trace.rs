@@ -1,6 +1,6 @@
 //! Exact real-ray tracing through an [`OpticalSystem`].
 
-use super::surface::{refract, V3};
+use super::surface::{dot, refract, V3};
 use super::system::OpticalSystem;
 
 /// A ray: position (mm), unit direction and optical path accumulated so far (mm).
@@ -37,6 +37,26 @@ impl Ray {
     #[inline]
     pub fn to_plane(&self, z_mm: f64) -> f64 {
         (z_mm - self.p[2]) / self.d[2]
+    }
+}
+
+// Here rather than in `system`: a system is what rays cross, the ray belongs to the tracer.
+impl OpticalSystem {
+    /// Where a ray (already in the vitreous, travelling towards +z) meets the retina; `None`
+    /// when it misses a spherical retina.
+    pub fn retina_hit(&self, ray: &Ray) -> Option<V3> {
+        let r = self.retina_radius_mm;
+        if !r.is_finite() {
+            return Some(ray.at(ray.to_plane(self.retina_z_mm)));
+        }
+        let q = [ray.p[0], ray.p[1], ray.p[2] - (self.retina_z_mm - r)];
+        let b = dot(ray.d, q);
+        let disc = b * b - (dot(q, q) - r * r);
+        if disc < 0.0 {
+            return None;
+        }
+        // The far intersection: the back wall of the globe, which the light reaches.
+        Some(ray.at(-b + disc.sqrt()))
     }
 }
 

@@ -21,7 +21,8 @@ use super::buffer::Buffer;
 use super::commands::Recorder;
 use super::error::{GpuError, GpuResult};
 use super::image::{Image, Sampler};
-use super::pipeline::{Binding, BindingKind, ComputePipeline, Layout};
+use super::pipeline::{Binding, ComputePipeline, Layout};
+use super::reflect::BindingKind;
 
 /// Something a pass binds under a name: one resource (a buffer, a storage image, an image
 /// with its sampler, a `Binding`), or a numbered family bound as `name0`, `name1`, … (an array

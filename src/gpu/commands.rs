@@ -8,7 +8,8 @@ use super::buffer::Buffer;
 use super::context::Context;
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::Image;
-use super::pipeline::{Binding, BindingKind, ComputePipeline, PipelineParts};
+use super::pipeline::{Binding, ComputePipeline, PipelineParts};
+use super::reflect::BindingKind;
 use super::submit_slot::{SubmitSlot, MAX_TIMED_PASSES, SETS_PER_POOL};
 
 /// GPU time of each named pass of one submission, in recording order.

@@ -13,7 +13,8 @@ use ash::vk;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::{Image, TexelFormat};
-use super::pipeline::{BindingKind, Layout, PipelineParts};
+use super::pipeline::{Layout, PipelineParts};
+use super::reflect::BindingKind;
 
 /// The type of one vertex attribute (32-bit floats).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -32,8 +32,8 @@ pub use graphics::{
     VertexAttribute, VertexFormat,
 };
 pub use image::{Edge, Image, ImageUsage, Sampler, TexelFormat};
-pub use pipeline::{Binding, BindingKind, ComputePipeline, ComputePipelineBuilder};
-pub use reflect::{reflect, Access, BlockLayout, ReflectedBinding, Reflection};
+pub use pipeline::{Binding, ComputePipeline, ComputePipelineBuilder};
+pub use reflect::{reflect, Access, BindingKind, BlockLayout, ReflectedBinding, Reflection};
 
 pub use ash::vk;
 

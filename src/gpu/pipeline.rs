@@ -11,29 +11,7 @@ use super::buffer::Buffer;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::{Image, Sampler};
-use super::reflect::{reflect, Access, BlockLayout};
-
-/// The kind of resource a shader binding expects.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BindingKind {
-    StorageBuffer,
-    UniformBuffer,
-    /// `sampler2D` / `sampler3D`: image plus sampler.
-    SampledImage,
-    /// `image2D` / `image3D` with imageLoad / imageStore.
-    StorageImage,
-}
-
-impl BindingKind {
-    pub(crate) fn descriptor_type(self) -> vk::DescriptorType {
-        match self {
-            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
-            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
-            BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
-        }
-    }
-}
+use super::reflect::{reflect, Access, BindingKind, BlockLayout};
 
 /// A resource bound to one binding slot at dispatch time.
 #[derive(Clone, Copy)]

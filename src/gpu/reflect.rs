@@ -4,7 +4,30 @@
 //! reports (src/gpu/bind.rs), and the recorder derives barriers from the access
 //! (src/gpu/access.rs): the binding order is written once, in the shader.
 
-use super::pipeline::BindingKind;
+use ash::vk;
+
+/// The kind of resource a shader binding expects: what reflection reads, so it lives here and
+/// the pipelines built from a reflection depend on it, not the reverse.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    StorageBuffer,
+    UniformBuffer,
+    /// `sampler2D` / `sampler3D`: image plus sampler.
+    SampledImage,
+    /// `image2D` / `image3D` with imageLoad / imageStore.
+    StorageImage,
+}
+
+impl BindingKind {
+    pub(crate) fn descriptor_type(self) -> vk::DescriptorType {
+        match self {
+            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            BindingKind::SampledImage => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
+        }
+    }
+}
 
 /// How a shader uses a binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -25,6 +25,7 @@
 //! at the object distance.
 
 use super::axes::KernelSettings;
+use super::field_shape::FieldShape;
 use crate::eye::field::measure_field;
 use crate::eye::{focus_within_range, Eye, FocusLimit};
 use crate::optics::beta::beta_from_alpha;
@@ -52,8 +53,8 @@ pub struct ChannelOptics {
     /// Ray displacement of the residual wavefront, ∇W/λ (λ/NA), at pupil points (x, y).
     slopes: Vec<([f64; 2], [f64; 2])>,
     /// Off axis: how the elliptical pupil maps onto the disc the wavefront is fitted over
-    /// (see [`super::field`]); `None` on axis.
-    pub field: Option<super::field::FieldShape>,
+    /// (see [`super::field_shape`]); `None` on axis.
+    pub field: Option<FieldShape>,
 }
 
 impl ChannelOptics {
@@ -125,7 +126,7 @@ impl ChannelOptics {
 
     /// ENZ defocus parameter for an object at `object_d` dioptres (see the module docs).
     /// Off axis this is the isotropic part over the stretched disc (the astigmatic part is
-    /// added to each PSF's wavefront, see [`super::field`]).
+    /// added to each PSF's wavefront, see [`super::field_psf`]).
     pub fn defocus_f(&self, object_d: f64) -> f64 {
         let r = 0.5e-3 * self.pupil_mm;
         let delta = self.focus_vergence - self.vergence_at_pupil(object_d);
@@ -299,7 +300,7 @@ fn measure_channels(
             settings,
         );
         if field_deg != [0.0, 0.0] {
-            ch.field = Some(super::field::FieldShape::from_pupil(&fm.field, pupil_mm));
+            ch.field = Some(FieldShape::from_pupil(&fm.field, pupil_mm));
         }
         channels.push(ch);
     }

@@ -4,7 +4,7 @@
 
 use super::axes::{KernelSettings, Screen};
 use super::defocus::ColumnOptics;
-use super::project::cropped_psf;
+use super::field_psf::cropped_psf;
 use crate::eye::Eye;
 use crate::Result;
 use std::collections::HashMap;

@@ -8,11 +8,12 @@
 
 use super::axes::{GridAxes, KernelSettings, Screen};
 use super::defocus::ColumnOptics;
+use super::field_psf::cropped_psf;
 use super::integrate::BoxIntegrator;
 use super::kernels::{
     kernel_side, level_block_radius, level_count, level_radius_px, KernelGrid, KernelSet,
 };
-use super::project::{cropped_psf, PsfMethod, MAX_BINS};
+use super::project::{PsfMethod, MAX_BINS};
 use crate::eye::Eye;
 use crate::{Error, Result};
 use rayon::prelude::*;

@@ -6,7 +6,9 @@
 //! - [`integrate`]: the PSF integrated over screen pixels of any size.
 //! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs.
 //! - [`exact`]: exact kernels at any vergence for the ground truth.
-//! - [`field`]: kernels for a direction of the visual field (elliptical pupil);
+//! - [`field_shape`]: a field direction's elliptical pupil; [`field_psf`]: a channel's PSF
+//!   anywhere in the field (the on-axis one, or the disc's resampled onto the ellipse);
+//!   [`field`]: kernels for a direction of the visual field;
 //!   [`field_plan`]: which directions a frame needs; [`field_kernels`]: the runtime's kernels
 //!   over those directions.
 //! - [`cache`]: grid files and the on-disk cache; [`preview`]: contact sheet and size plot.
@@ -19,6 +21,8 @@ pub mod exact;
 pub mod field;
 pub mod field_kernels;
 pub mod field_plan;
+pub mod field_psf;
+pub mod field_shape;
 pub mod grid;
 pub mod integrate;
 pub mod kernels;

@@ -142,20 +142,6 @@ pub fn pixel_lambda_na(ch: &ChannelOptics, screen: &Screen) -> f64 {
     1.0 / (screen.px_per_radian() * ch.radians_per_lambda_na())
 }
 
-/// Computes the PSF of `ch` for an object at `object_d` dioptres and crops it.
-pub fn cropped_psf(
-    ch: &ChannelOptics,
-    object_d: f64,
-    screen: &Screen,
-    settings: &KernelSettings,
-) -> Result<CroppedPsf> {
-    if let Some(shape) = &ch.field {
-        return super::field::cropped_field_psf(ch, shape, object_d, screen, settings);
-    }
-    let f = ch.defocus_f(object_d);
-    cropped_psf_at_f(ch, f, screen, settings)
-}
-
 /// The grid a PSF at defocus f is computed on: (pitch in λ/NA, half side in samples). The grid
 /// covers the geometric (ray) extent plus the diffraction margin; beyond [`MAX_PSF_SIDE`] the
 /// pitch grows, but never past `samples_per_pixel / 2` samples per pixel.
@@ -193,7 +179,7 @@ pub fn enz_cost(degree: u32, size: usize) -> f64 {
 const ENZ_PIXEL_UNITS: f64 = 5.0;
 const ENZ_RADIUS_UNITS: f64 = 2.0;
 
-/// As [`cropped_psf`] for a given total defocus f. The method is chosen per PSF: the ENZ
+/// As [`super::field_psf::cropped_psf`] on axis, for a given total defocus f. The method is chosen per PSF: the ENZ
 /// series where the channel's β expansion met its tolerance and is the cheaper of the two,
 /// else the transform of the sampled pupil.
 pub fn cropped_psf_at_f(

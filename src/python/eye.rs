@@ -183,8 +183,9 @@ impl PyEye {
         max_time_s: Option<f64>,
     ) -> PyResult<PyEye> {
         check_pupil("--pupil-mm", pupil_mm).map_err(super::to_py)?;
-        let target = estimate::RxTarget::new(rx, pupil_mm, wavelength_nm, Some(vertex_mm))
-            .map_err(|e| super::to_py(estimate_error(e)))?;
+        let target =
+            estimate::prescription::RxTarget::new(rx, pupil_mm, wavelength_nm, Some(vertex_mm))
+                .map_err(|e| super::to_py(estimate_error(e)))?;
         let source = format!(
             "Eye.from_rx({rx:?}, pupil_mm={pupil_mm}, wavelength_nm={}, vertex_mm={})",
             target.wavelength_nm, target.vertex_mm

@@ -34,7 +34,11 @@ pub const FAR_FOCUS_M: f64 = 1e4;
 /// direction; background (+∞, 0, NaN, negative) is optical infinity. Per-pixel conversions go
 /// through [`pixel_vergence_d`] (distance along the ray).
 pub fn vergence_of_depth_d(depth_m: f32) -> f64 {
-    crate::render::reference::dioptre_of_depth(depth_m)
+    if depth_m > 0.0 && depth_m.is_finite() {
+        1.0 / f64::from(depth_m)
+    } else {
+        0.0
+    }
 }
 
 /// Where a pixel lies on the screen, for conversions that depend on its ray.

@@ -5,7 +5,8 @@
 //! their own where they differ (the luminance's label).
 
 use crate::eye::age::{hofstetter_amplitude_d, HofstetterLine};
-use crate::eye::correction::{emmetropic_iol_power_d, Iol, Spectacle, DEFAULT_VERTEX_MM};
+use crate::eye::correction::{Iol, Spectacle, DEFAULT_VERTEX_MM};
+use crate::eye::refract::emmetropic_iol_power_d;
 use crate::eye::Eye;
 use crate::optics::pupil::{moon_spencer_mm, watson_yellott_mm, Viewing};
 use crate::render::focus::{

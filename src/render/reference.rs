@@ -10,6 +10,7 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use super::blend::{background_behind, BlendSettings, PixelBlend};
+use super::focus::vergence_of_depth_d;
 use super::projection::LocalScale;
 use super::splat::FrameInput;
 
@@ -18,15 +19,6 @@ pub const DIOPTRE_BIN_D: f64 = 0.001;
 
 // The kernel types live with the exact PSFs in `psf`; the renderers here consume them.
 pub use crate::psf::exact::{ExactKernels, Kernel};
-
-/// Vergence of a depth in metres; 0, negative, NaN or infinite depth is optical infinity.
-pub fn dioptre_of_depth(depth_m: f32) -> f64 {
-    if depth_m > 0.0 && depth_m.is_finite() {
-        1.0 / f64::from(depth_m)
-    } else {
-        0.0
-    }
-}
 
 fn bin_of(dioptre: f64, bin_d: f64) -> i64 {
     (dioptre / bin_d).round() as i64
@@ -67,7 +59,11 @@ pub fn render_binned(
     let dioptres: Vec<f64> = if wide {
         projection.dioptres(input.depth_m)
     } else {
-        input.depth_m.iter().map(|&d| dioptre_of_depth(d)).collect()
+        input
+            .depth_m
+            .iter()
+            .map(|&d| vergence_of_depth_d(d))
+            .collect()
     };
     // Off axis each pixel also has a field bin: (h, v) rounded to the source's field step.
     let field_bins: Vec<(i64, i64)> = match kernels.field_step_deg() {

@@ -4,8 +4,9 @@
 
 use ocular::eye::accommodate::exerted_accommodation_d;
 use ocular::eye::age::{hofstetter_amplitude_d, HofstetterLine};
-use ocular::eye::correction::{emmetropic_iol_power_d, Iol, Spectacle};
+use ocular::eye::correction::{Iol, Spectacle};
 use ocular::eye::media::{eye_index, Medium};
+use ocular::eye::refract::emmetropic_iol_power_d;
 use ocular::eye::refract::refract;
 use ocular::eye::trace::{trace_range, Ray};
 use ocular::eye::{file, focus_within_range, Eye, FocusLimit, Measurer};

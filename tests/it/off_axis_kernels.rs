@@ -10,7 +10,7 @@ use ocular::eye::Eye;
 use ocular::optics::zernike::basis_values;
 use ocular::psf::axes::{KernelSettings, Screen};
 use ocular::psf::field::{field_column, frame_half_field_deg, FieldAxes};
-use ocular::psf::project::cropped_psf;
+use ocular::psf::field_psf::cropped_psf;
 
 /// Variances (rad²) of the ray angle along x and y over the ellipse with semi-axes `a`
 /// (mm), for the wavefront Σ c_j Z_j(x/a₀, y/a₁) + ΔD·|q|²/2 (µm, q in mm).

@@ -378,7 +378,7 @@ fn traced_radial_skewness(theta_deg: f64) -> f64 {
 fn kernel_skewness(h_deg: f64) -> f64 {
     use ocular::psf::axes::{KernelSettings, Screen};
     use ocular::psf::field::field_column;
-    use ocular::psf::project::cropped_psf;
+    use ocular::psf::field_psf::cropped_psf;
     let settings = KernelSettings::default();
     let col = field_column(
         &Eye::navarro_wide(),

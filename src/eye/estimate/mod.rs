@@ -20,7 +20,8 @@ pub mod pattern_search;
 pub mod prescription;
 
 use crate::aberrations::ZernikeSet;
-use crate::eye::model::{Eye, EyeError};
+use crate::eye::error::EyeError;
+use crate::eye::model::Eye;
 use crate::optics::zernike::{num_terms, osa_index, osa_nm};
 use least_squares::{levenberg_marquardt, LmSettings};
 use loss::{Evaluator, Objective, ORDER_WEIGHTS};
@@ -29,8 +30,6 @@ use pattern_search::{pattern_search, GpsSettings, Limits, Outcome, Stop};
 use serde::Serialize;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
-
-pub use prescription::RxTarget;
 
 /// The hybrid's polish ends when this many pattern-search iterations together gain less
 /// than this fraction of the loss. Where the input is not exactly reachable (keratoconus:

@@ -15,7 +15,8 @@ use super::{
 };
 use crate::aberrations::ZernikeSet;
 use crate::eye::correction::{DEFAULT_VERTEX_MM, VERTEX_RANGE_MM};
-use crate::eye::model::{Eye, EyeError};
+use crate::eye::error::EyeError;
+use crate::eye::model::Eye;
 use crate::eye::refract::{spectacle_to_pupil_rx, REFRACTION_WAVELENGTH_NM};
 use crate::optics::zernike::Prescription;
 

@@ -226,7 +226,7 @@ pub fn hdr_flip(
                 .collect();
             [0, 1, 2].map(|i| Plane::new(img.width, img.height, rgb.iter().map(|v| v[i]).collect()))
         };
-        let errors = super::flip_planes(&mapped(reference), &mapped(test), ppd);
+        let errors = super::ldr::flip_planes(&mapped(reference), &mapped(test), ppd);
         let at = if exposures.len() > 1 {
             k as f32 / (exposures.len() - 1) as f32
         } else {
