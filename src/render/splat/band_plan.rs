@@ -24,15 +24,17 @@ pub(super) struct BandPlanPass {
     pipeline: ComputePipeline,
 }
 
-impl BandPlanPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for BandPlanPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("band plan", crate::shaders::RENDER_SPLAT_BAND_PLAN_COMP)
                 .push_constants::<BandPlanPush>()
                 .build(ctx)?;
         Ok(BandPlanPass { pipeline })
     }
+}
 
+impl BandPlanPass {
     /// Plans `slots` slots of the band table for a list buffer of `capacity` entries, from
     /// the tile counts and offsets (tiles + 1 each).
     pub fn record(

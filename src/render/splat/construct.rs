@@ -3,9 +3,8 @@
 
 use super::bands::{band_table_bytes, BAND_TABLE_HEADER_BYTES};
 use super::{
-    band_header_at, band_plan, binding_limit, convolve, field, fragments, input, merge, prefix_sum,
-    psf_texture, tile_count, tile_fill, tile_sort, FrameResources, SplatSettings, Splatter,
-    FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
+    band_header_at, binding_limit, field, fragments, passes, psf_texture, FrameResources, Passes,
+    SplatSettings, Splatter, FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
 };
 use crate::gpu::{
     Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat,
@@ -120,21 +119,15 @@ impl Splatter {
             core_radii,
             frame: None,
             entries: None,
-            input: input::InputPass::new(ctx)?,
-            psf_texture: psf_texture::PsfTexturePass::new(ctx)?,
-            fragments_pass: fragments::FragmentsPass::new(ctx)?,
-            merge: merge::MergePass::new(ctx)?,
-            tile_count: tile_count::TileCountPass::new(ctx)?,
-            prefix_sum: prefix_sum::PrefixSumPass::new(ctx)?,
-            tile_fill: tile_fill::TileFillPass::new(ctx)?,
-            tile_sort: tile_sort::TileSortPass::new(ctx)?,
-            band_plan: band_plan::BandPlanPass::new(ctx)?,
-            convolve: convolve::ConvolvePass::new(
+            passes: Passes::new(
                 ctx,
-                settings.tile_size,
-                off_axis,
-                settings.blend.mode == crate::render::blend::BlendMode::PerFragment,
-                settings.convolve_walk.visits_on(ctx.device_info().kind),
+                &passes::PassConfig {
+                    tile_size: settings.tile_size,
+                    off_axis,
+                    per_fragment: settings.blend.mode
+                        == crate::render::blend::BlendMode::PerFragment,
+                    visit_slots: settings.convolve_walk.visits_on(ctx.device_info().kind),
+                },
             )?,
             grid,
         })

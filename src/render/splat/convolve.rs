@@ -4,41 +4,38 @@
 use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
 
 use super::bands::{dispatch_offset, BandPush, BandSlot};
+use super::passes::PassConfig;
 use super::Resources;
 
 pub(super) struct ConvolvePass {
     pipeline: ComputePipeline,
 }
 
-impl ConvolvePass {
-    /// `off_axis`: the four-node kernels of a field lattice (src/render/splat/field.rs);
-    /// `per_fragment`: the seed paper's blend instead of depth groups (a pipeline constant of
-    /// the visits walk; convolve.comp reads it from the frame block); `visit_slots`: the walk for
-    /// CPU implementations (glsl/render/splat/convolve_visits.comp says why).
-    pub fn new(
-        ctx: &Context,
-        tile_size: u32,
-        off_axis: bool,
-        per_fragment: bool,
-        visit_slots: bool,
-    ) -> GpuResult<Self> {
-        let builder = if visit_slots {
+impl super::passes::Pass for ConvolvePass {
+    /// Off axis the four-node kernels of a field lattice (src/render/splat/field.rs); the
+    /// per-fragment blend is a pipeline constant of the visits walk (convolve.comp reads it
+    /// from the frame block); `visit_slots` picks the walk for CPU implementations
+    /// (glsl/render/splat/convolve_visits.comp says why).
+    fn new(ctx: &Context, config: &PassConfig) -> GpuResult<Self> {
+        let builder = if config.visit_slots {
             ComputePipeline::builder(
                 "convolve",
                 crate::shaders::RENDER_SPLAT_CONVOLVE_VISITS_COMP,
             )
-            .specialize(2, u32::from(per_fragment))
+            .specialize(2, u32::from(config.per_fragment))
         } else {
             ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
         };
         let pipeline = builder
             .push_constants::<BandPush>()
-            .specialize(0, tile_size)
-            .specialize(1, u32::from(off_axis))
+            .specialize(0, config.tile_size)
+            .specialize(1, u32::from(config.off_axis))
             .build(ctx)?;
         Ok(ConvolvePass { pipeline })
     }
+}
 
+impl ConvolvePass {
     /// Blends the band in `band.push.slot` of the band table into the output image, one
     /// workgroup per tile, dispatched as the table says.
     pub fn record(

@@ -104,15 +104,17 @@ pub(super) struct FragmentsPass {
     pipeline: ComputePipeline,
 }
 
-impl FragmentsPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for FragmentsPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("fragments", crate::shaders::RENDER_SPLAT_FRAGMENTS_COMP)
                 .push_constants::<FragmentsPush>()
                 .build(ctx)?;
         Ok(FragmentsPass { pipeline })
     }
+}
 
+impl FragmentsPass {
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,

@@ -87,8 +87,8 @@ pub(super) struct InputPass {
     pipeline: ComputePipeline,
 }
 
-impl InputPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for InputPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("input", crate::shaders::RENDER_SPLAT_INPUT_COMP)
             .push_constants::<InputPush>()
             .build(ctx)?;

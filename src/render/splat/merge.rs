@@ -22,14 +22,16 @@ pub(super) struct MergePass {
     pipeline: ComputePipeline,
 }
 
-impl MergePass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for MergePass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline = ComputePipeline::builder("merge", crate::shaders::RENDER_SPLAT_MERGE_COMP)
             .push_constants::<MergePush>()
             .build(ctx)?;
         Ok(MergePass { pipeline })
     }
+}
 
+impl MergePass {
     /// `levels`: 1 merges 2×2 blocks, 2 also merges 2×2 blocks of merged blocks, and so on.
     pub fn record(
         &self,

@@ -8,29 +8,33 @@
 //! GPU from the prefix sum, so nothing is ever dropped and a banded frame is still one
 //! submission.
 //!
-//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`; `construct` builds a
-//! splatter, `settings` holds its options, `field` the off-axis lattice, `bands` the planning
+//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`, listed once in
+//! `passes!` below (`passes` says how to add one); `construct` builds a splatter, `settings` holds its options, `field` the off-axis lattice, `bands` the planning
 //! of tile-row bands, `uniform` the frame's uniform block. Values every dispatch of a frame
 //! shares are in that block (one persistent buffer, written through its mapping); values that
 //! change between dispatches are each pass's own typed push constants.
 
-mod band_plan;
 mod bands;
 #[cfg(test)]
 mod block_layouts;
 mod construct;
-mod convolve;
 mod field;
-mod fragments;
-mod input;
-mod merge;
-mod prefix_sum;
-mod psf_texture;
+mod passes;
 mod settings;
-mod tile_count;
-mod tile_fill;
-mod tile_sort;
 mod uniform;
+
+passes::passes! {
+    input: input::InputPass,
+    psf_texture: psf_texture::PsfTexturePass,
+    fragments: fragments::FragmentsPass,
+    merge: merge::MergePass,
+    tile_count: tile_count::TileCountPass,
+    prefix_sum: prefix_sum::PrefixSumPass,
+    band_plan: band_plan::BandPlanPass,
+    tile_fill: tile_fill::TileFillPass,
+    tile_sort: tile_sort::TileSortPass,
+    convolve: convolve::ConvolvePass,
+}
 
 use crate::gpu::{Buffer, Context, GpuError, Image, Residency, Sampler, Timings};
 use crate::psf::kernels::KernelGrid;
@@ -210,16 +214,7 @@ pub struct Splatter {
     core_radii: Vec<Vec<[f32; 3]>>,
     frame: Option<FrameResources>,
     entries: Option<Buffer>,
-    input: input::InputPass,
-    psf_texture: psf_texture::PsfTexturePass,
-    fragments_pass: fragments::FragmentsPass,
-    merge: merge::MergePass,
-    tile_count: tile_count::TileCountPass,
-    prefix_sum: prefix_sum::PrefixSumPass,
-    tile_fill: tile_fill::TileFillPass,
-    tile_sort: tile_sort::TileSortPass,
-    band_plan: band_plan::BandPlanPass,
-    convolve: convolve::ConvolvePass,
+    passes: Passes,
 }
 
 /// Largest tile side of the off-axis convolution.
@@ -584,7 +579,7 @@ impl Splatter {
         hidden: fragments::HiddenLight,
     ) -> crate::gpu::GpuResult<()> {
         let frame = r.frame;
-        source.record(rec, &self.input, frame)?;
+        source.record(rec, &self.passes.input, frame)?;
         rec.copy_buffer(&self.radii_staging, &self.radii, self.radii.size_bytes());
         rec.copy_buffer(
             &self.field_table.staging,
@@ -601,15 +596,17 @@ impl Splatter {
                 rec.clear_image(&self.texture, [0.0; 4]);
             }
             let blocks: Vec<field::BlockKernels> = self.layout.blocks.iter().map(|b| b.0).collect();
-            self.psf_texture
+            self.passes
+                .psf_texture
                 .record(rec, r, &self.resident, blend, &blocks)?;
         }
         rec.begin_pass("fragments");
-        self.fragments_pass.record(rec, r, hidden)?;
+        self.passes.fragments.record(rec, r, hidden)?;
         let merge = &self.settings.merge;
         if merge.levels > 0 {
             rec.begin_pass("merge");
-            self.merge
+            self.passes
+                .merge
                 .record(rec, r, (merge.levels, merge.blur_per_block))?;
         }
         rec.begin_pass("tile count");
@@ -617,9 +614,9 @@ impl Splatter {
         // pixel of its tiles): the host checks the frame it reads back.
         rec.clear_image(&frame.color_out, [0.0; 4]);
         rec.fill_buffer(&frame.counts, 0);
-        self.tile_count.record(rec, r)?;
+        self.passes.tile_count.record(rec, r)?;
         rec.begin_pass("prefix sum");
-        self.prefix_sum.record(rec, r)?;
+        self.passes.prefix_sum.record(rec, r)?;
         Ok(())
     }
 
@@ -635,7 +632,9 @@ impl Splatter {
         let frame = r.frame;
         let entry_capacity = entries_in(entries);
         rec.begin_pass("band plan");
-        self.band_plan.record(rec, r, (slots, entry_capacity))?;
+        self.passes
+            .band_plan
+            .record(rec, r, (slots, entry_capacity))?;
         for slot in 0..slots {
             let band = BandSlot {
                 push: BandPush {
@@ -646,11 +645,11 @@ impl Splatter {
             };
             rec.begin_pass("tile fill");
             rec.fill_buffer(&frame.cursors, 0);
-            self.tile_fill.record(rec, r, &band)?;
+            self.passes.tile_fill.record(rec, r, &band)?;
             rec.begin_pass("tile sort");
-            self.tile_sort.record(rec, r, &band)?;
+            self.passes.tile_sort.record(rec, r, &band)?;
             rec.begin_pass("convolve");
-            self.convolve.record(rec, r, &band)?;
+            self.passes.convolve.record(rec, r, &band)?;
         }
         rec.copy_buffer_region(
             &frame.band_table,

@@ -21,15 +21,17 @@ pub(super) struct PrefixSumPass {
     pipeline: ComputePipeline,
 }
 
-impl PrefixSumPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for PrefixSumPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("prefix sum", crate::shaders::RENDER_SPLAT_PREFIX_SUM_COMP)
                 .push_constants::<PrefixSumPush>()
                 .build(ctx)?;
         Ok(PrefixSumPass { pipeline })
     }
+}
 
+impl PrefixSumPass {
     /// Scans the tile counts into the offsets (tiles + 1 elements: the total last).
     pub fn record(&self, rec: &mut Recorder<'_>, r: &Resources<'_>) -> GpuResult<()> {
         let count = r.frame.tiles_x * r.frame.tiles_y;

@@ -176,15 +176,17 @@ pub(super) struct PsfTexturePass {
     pipeline: ComputePipeline,
 }
 
-impl PsfTexturePass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for PsfTexturePass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("psf texture", crate::shaders::RENDER_SPLAT_PSF_TEXTURE_COMP)
                 .push_constants::<PsfTexturePush>()
                 .build(ctx)?;
         Ok(PsfTexturePass { pipeline })
     }
+}
 
+impl PsfTexturePass {
     /// Writes each field node's kernels for `blend` into its region of the PSF texture, whose
     /// layout the atlas holds (glsl/common/atlas.glsl): per node of `nodes` (on axis one), the
     /// plain kernels, then per block side of `blocks` its block-summed ones (a block's texels

@@ -9,14 +9,16 @@ pub(super) struct TileCountPass {
     pipeline: ComputePipeline,
 }
 
-impl TileCountPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for TileCountPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
                 .build(ctx)?;
         Ok(TileCountPass { pipeline })
     }
+}
 
+impl TileCountPass {
     /// `r.frame.counts` must be zeroed (tiles + 3 elements: the live fragments and the kernel
     /// evaluations follow the tiles).
     pub fn record(&self, rec: &mut Recorder<'_>, r: &Resources<'_>) -> GpuResult<()> {

@@ -10,15 +10,17 @@ pub(super) struct TileFillPass {
     pipeline: ComputePipeline,
 }
 
-impl TileFillPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for TileFillPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let pipeline =
             ComputePipeline::builder("tile fill", crate::shaders::RENDER_SPLAT_TILE_FILL_COMP)
                 .push_constants::<BandPush>()
                 .build(ctx)?;
         Ok(TileFillPass { pipeline })
     }
+}
 
+impl TileFillPass {
     /// `r.frame.cursors` must be zeroed; `band.entries` receives the lists of the band in
     /// `band.push.slot` of the band table.
     pub fn record(

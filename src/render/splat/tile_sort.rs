@@ -10,8 +10,8 @@ pub(super) struct TileSortPass {
     pipeline: ComputePipeline,
 }
 
-impl TileSortPass {
-    pub fn new(ctx: &Context) -> GpuResult<Self> {
+impl super::passes::Pass for TileSortPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
         let cpu = ctx.device_info().kind == crate::gpu::DeviceKind::Cpu;
         let pipeline =
             ComputePipeline::builder("tile sort", crate::shaders::RENDER_SPLAT_TILE_SORT_COMP)
@@ -21,7 +21,9 @@ impl TileSortPass {
                 .build(ctx)?;
         Ok(TileSortPass { pipeline })
     }
+}
 
+impl TileSortPass {
     /// One workgroup per tile of the band in `band.push.slot` of the band table, dispatched
     /// as the table says.
     pub fn record(
