@@ -1,4 +1,4 @@
-// Where the PSF texture keeps each kernel (`TextureLayout` in src/render/splat/field.rs): an
+// Where the PSF texture keeps each kernel (`TextureLayout` in src/render/splat/atlas.rs): an
 // atlas with one region per field node (on axis one), regions row by row, each holding one
 // slot per radius level, (2r+1)² texels inside a zero ring, and where merging makes blocks of
 // 4×4 pixels and up, per such side s the levels' kernels summed over the block, (2r+s)² texels

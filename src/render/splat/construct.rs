@@ -3,8 +3,8 @@
 
 use super::bands::{band_table_bytes, BAND_TABLE_HEADER_BYTES};
 use super::{
-    band_header_at, binding_limit, field, fragments, passes, psf_texture, FrameResources, Passes,
-    SplatSettings, Splatter, FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
+    atlas, band_header_at, binding_limit, field, fragments, passes, psf_texture, FrameResources,
+    Passes, SplatSettings, Splatter, FRAGMENT_BYTES, FRAME_UNIFORM_BYTES, MAX_OFF_AXIS_TILE,
 };
 use crate::gpu::{
     Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat,
@@ -62,8 +62,8 @@ impl Splatter {
                 settings.tile_size
             )));
         }
-        let blocks = field::block_kernels(&settings.merge, grid.max_radius_px);
-        let layout = field::TextureLayout::new(&grid, field_axes.as_ref(), &blocks);
+        let blocks = atlas::block_kernels(&settings.merge, grid.max_radius_px);
+        let layout = atlas::TextureLayout::new(&grid, field_axes.as_ref(), &blocks);
         layout.check(ctx, settings.texture_format.texel_bytes())?;
         let nodes: &[KernelGrid] = if node_grids.is_empty() {
             std::slice::from_ref(&grid)

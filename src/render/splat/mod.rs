@@ -8,12 +8,14 @@
 //! GPU from the prefix sum, so nothing is ever dropped and a banded frame is still one
 //! submission.
 //!
-//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`, listed once in
-//! `passes!` below (`passes` says how to add one); `construct` builds a splatter, `settings` holds its options, `field` the off-axis lattice, `bands` the planning
-//! of tile-row bands, `uniform` the frame's uniform block. Values every dispatch of a frame
-//! shares are in that block (one persistent buffer, written through its mapping); values that
-//! change between dispatches are each pass's own typed push constants.
+//! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`, listed once in `passes!`
+//! below (`passes` says how to add one); `construct` builds a splatter, `settings` holds its
+//! options, `atlas` the PSF texture's layout, `field` the off-axis lattice, `bands` the planning of
+//! tile-row bands, `uniform` the frame's uniform block. Values every dispatch of a frame shares are
+//! in that block (one persistent buffer, written through its mapping); values that change between
+//! dispatches are each pass's own typed push constants.
 
+mod atlas;
 mod bands;
 #[cfg(test)]
 mod block_layouts;
@@ -197,7 +199,7 @@ pub struct Splatter {
     field_axes: Option<crate::psf::field::FieldAxes>,
     /// Per node (on axis one), every kernel set resident on the GPU.
     resident: Vec<psf_texture::ResidentGrid>,
-    layout: field::TextureLayout,
+    layout: atlas::TextureLayout,
     /// The texture's layout for the shaders (glsl/common/atlas.glsl), written once.
     atlas: Buffer,
     field_table: field::FieldTable,
@@ -595,7 +597,7 @@ impl Splatter {
                 // (Measured: without it, two splat tests read NaN on lavapipe.)
                 rec.clear_image(&self.texture, [0.0; 4]);
             }
-            let blocks: Vec<field::BlockKernels> = self.layout.blocks.iter().map(|b| b.0).collect();
+            let blocks: Vec<atlas::BlockKernels> = self.layout.blocks.iter().map(|b| b.0).collect();
             self.passes
                 .psf_texture
                 .record(rec, r, &self.resident, blend, &blocks)?;

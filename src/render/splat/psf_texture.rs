@@ -9,7 +9,7 @@ use crate::psf::kernels::{
     level_block_radius, level_count, texels_below_level, GridBlend, KernelGrid, KernelSet,
 };
 
-use super::field::BlockKernels;
+use super::atlas::BlockKernels;
 use super::Resources;
 
 shader_block! {
@@ -25,7 +25,7 @@ shader_block! {
         /// Index of the chunk's first texel in a whole kernel set.
         pub first_texel: u32,
         /// The field node (h-major; on axis 0) whose region of the atlas is written
-        /// (`field::TextureLayout`).
+        /// (`atlas::TextureLayout`).
         pub node: u32,
         /// Bilinear weights of the (up to) four grid states; unused corners weigh zero.
         pub corner_weights: [f32; 4],
