@@ -45,6 +45,12 @@ layout(std140, binding = FRAME_BINDING) uniform FrameUniform {
     float saturation_epsilon; // convolution stops once every pixel's coverage is ≥ 1 − ε
     uint fragments_per_chunk; // see FRAGMENT_BUFFERS
     uint layers;           // depth layers stacked in the inputs and fragments (1 = visible only)
+    // 1: the convolution reads each object distance's own kernel from the layer texture
+    // (glsl/common/layer_atlas.glsl), one read for all channels; 0: the radius levels.
+    uint layered;
+    // Layered: the largest radius step (px) between neighbouring object distances, which a
+    // fragment between them may reach past its own radius; 0 otherwise.
+    float radius_step;
 } frame;
 
 // A frame's fragments live in one buffer, bound as four consecutive ranges of
@@ -186,7 +192,9 @@ vec3 pupil_share(uint size, vec3 radius, float inner, vec2 d) {
 // reaches up to (r + 1)/cos²θ, exclusive.
 float fragment_reach(Fragment f) {
     float radius = max(f.radius.r, max(f.radius.g, f.radius.b));
-    float r = ceil(radius);
+    // Layered, the two object distances' kernels around the fragment's are each as wide as
+    // their own radius, which lies within radius_step of the fragment's.
+    float r = ceil(radius + frame.radius_step);
     vec3 s = local_scale(f.center);
     vec2 c = shrink_for_radius(s.z, radius);
     uint size = block_size(f);

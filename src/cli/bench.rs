@@ -137,6 +137,9 @@ struct Report {
     max_radius_px: u32,
     /// Device memory of the PSF texture (bytes).
     psf_texture_bytes: u64,
+    /// Whether the convolution read each object distance's own kernel (one read per pixel and
+    /// fragment) rather than the radius levels (`--level-kernels`, or radii too far apart).
+    layer_kernels: bool,
     /// `--off-axis`: the field directions (degrees) the kernels were computed for.
     #[serde(skip_serializing_if = "Option::is_none")]
     field: Option<crate::psf::field::FieldAxes>,
@@ -179,6 +182,7 @@ struct TimedFrames {
     live_fragments: u64,
     kernel_evaluations: u64,
     psf_texture_bytes: u64,
+    layer_kernels: bool,
     counters: Counters,
 }
 
@@ -273,6 +277,7 @@ fn time_frames(
         live_fragments: 0,
         kernel_evaluations: 0,
         psf_texture_bytes: 0,
+        layer_kernels: false,
         counters: Counters::default(),
     };
     for i in 0..args.warmup + args.frames {
@@ -299,6 +304,7 @@ fn time_frames(
             t.live_fragments = s.live_fragments;
             t.kernel_evaluations = s.kernel_evaluations;
             t.psf_texture_bytes = s.psf_texture_bytes;
+            t.layer_kernels = s.layer_kernels;
             t.counters = Counters {
                 submissions: s.submissions,
                 bands: s.bands,
@@ -433,6 +439,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
             / (f64::from(width) * f64::from(height)),
         max_radius_px,
         psf_texture_bytes: timed.psf_texture_bytes,
+        layer_kernels: timed.layer_kernels,
         field,
         counters: timed.counters,
         baseline,
@@ -549,8 +556,16 @@ fn print_table(r: &Report) {
         r.psf_texture_bytes as f64 / f64::from(1u32 << 20)
     );
     println!(
-        "per frame: {} fragments after merging, {} list entries, {} kernel evaluations ({:.1} per pixel)",
-        r.live_fragments, r.list_entries, r.kernel_evaluations, r.evaluations_per_pixel
+        "per frame: {} fragments after merging, {} list entries, {} kernel evaluations ({:.1} per pixel), {}",
+        r.live_fragments,
+        r.list_entries,
+        r.kernel_evaluations,
+        r.evaluations_per_pixel,
+        if r.layer_kernels {
+            "one read each (layer kernels)"
+        } else {
+            "up to three reads each (radius levels)"
+        }
     );
     if let Some(f) = &r.field {
         println!(

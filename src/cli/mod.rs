@@ -196,6 +196,12 @@ pub struct SplatArgs {
         allow_hyphen_values = true
     )]
     pub merge_color_error: f32,
+    /// Read kernels at the radius levels around each fragment's radius (up to three filtered
+    /// reads per pixel and fragment) instead of each object distance's own kernel (one read).
+    /// By default the layer kernels are used where neighbouring distances' radii differ by at
+    /// most half a pixel (the default grid's 1/16 D steps), on axis.
+    #[arg(long)]
+    pub level_kernels: bool,
     #[command(flatten)]
     pub blend: BlendArgs,
     /// Aberrations across the visual field: each pixel gets the PSF of the eye traced for its
@@ -219,6 +225,7 @@ impl SplatArgs {
                 ..crate::render::splat::MergeSettings::default()
             },
             blend: self.blend.settings(),
+            layer_kernels: !self.level_kernels,
             ..crate::render::splat::SplatSettings::default()
         };
         settings.validate().map_err(|e| {

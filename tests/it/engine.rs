@@ -313,35 +313,65 @@ fn early_exit_changes_the_image_by_less_than_epsilon() {
     common::finish(ctx);
 }
 
-/// The convolution's two walks (pixels, for GPUs; visits, for CPU implementations) render the
-/// same image: depth groups and the paper's blend, merged blocks, a chromatic eye whose
-/// channels fall on different radius levels (so some fragments take several slots), and a
-/// near card over a blurred textured wall. Equal up to the order of float additions.
-#[test]
-fn convolve_walks_agree() {
-    let ctx = common::gpu();
-    let frame = Frame::new(|x, y| {
+/// The same synthetic eye on an object axis fine enough for the layer kernels: 1/32 D, where
+/// neighbouring distances' radii differ by at most a quarter pixel.
+fn grid_fine(focus_d: f64) -> KernelGrid {
+    let mut eye = SyntheticEye::new(focus_d, 3.0);
+    eye.pupil_scale = true;
+    eye.grid(DioptreAxis::spanning(0.0, 5.0, 161), 20, &[3.0, 5.0], H)
+}
+
+/// A near card over a blurred textured wall, both in the grid's range.
+fn card_frame() -> Frame {
+    Frame::new(|x, y| {
         if (30..60).contains(&x) && (20..40).contains(&y) {
             ([0.9, 0.3, 0.1], 0.3)
         } else {
             (textured(x, y).map(|v| 4.0 * v), 1.5)
         }
-    });
-    let run = |walk: ConvolveWalk, blend: BlendSettings| {
+    })
+}
+
+/// The convolution's two walks (pixels, for GPUs; visits, for CPU implementations) render the
+/// same image: depth groups and the paper's blend, merged blocks, a chromatic eye whose
+/// channels fall on different radius levels (so some fragments take several slots), and a
+/// near card over a blurred textured wall; both with the radius levels (a coarse object axis)
+/// and with the layer kernels (a fine one). Equal up to the order of float additions.
+#[test]
+fn convolve_walks_agree() {
+    let ctx = common::gpu();
+    let frame = card_frame();
+    let run = |walk: ConvolveWalk, blend: BlendSettings, grid: &KernelGrid, layered: bool| {
         let settings = SplatSettings {
             blend,
             convolve_walk: walk,
             ..SplatSettings::default()
         };
-        let mut splatter = Splatter::new(&ctx, grid_focused(2.0), settings).unwrap();
-        render(&mut splatter, &frame, VIEW).color
+        let mut splatter = Splatter::new(&ctx, grid.clone(), settings).unwrap();
+        let out = render(&mut splatter, &frame, VIEW);
+        assert_eq!(out.stats.layer_kernels, layered, "{walk:?}");
+        out.color
     };
-    for (blend, name) in [
-        (BlendSettings::default(), "depth groups"),
-        (BlendSettings::paper(), "the paper's blend"),
+    let coarse = grid_focused(2.0);
+    let fine = grid_fine(2.0);
+    for (blend, grid, layered, name) in [
+        (BlendSettings::default(), &coarse, false, "depth groups"),
+        (BlendSettings::paper(), &coarse, false, "the paper's blend"),
+        (
+            BlendSettings::default(),
+            &fine,
+            true,
+            "depth groups, layer kernels",
+        ),
+        (
+            BlendSettings::paper(),
+            &fine,
+            true,
+            "the paper's blend, layer kernels",
+        ),
     ] {
-        let pixels = run(ConvolveWalk::Pixels, blend);
-        let visits = run(ConvolveWalk::Visits, blend);
+        let pixels = run(ConvolveWalk::Pixels, blend, grid, layered);
+        let visits = run(ConvolveWalk::Visits, blend, grid, layered);
         let worst = pixels
             .iter()
             .zip(&visits)
@@ -354,6 +384,41 @@ fn convolve_walks_agree() {
     }
     common::finish(ctx);
 }
+
+/// The layer kernels (each object distance's own kernel, one read) against the radius levels
+/// they are built from (up to three reads, mixed at each fragment's radius): on a fine object
+/// axis the two differ only where a fragment lies between two distances, by the blend of two
+/// kernels a fraction of a pixel apart in radius.
+#[test]
+fn layer_kernels_match_the_radius_levels() {
+    let ctx = common::gpu();
+    let frame = card_frame();
+    let run = |layer_kernels: bool| {
+        let settings = SplatSettings {
+            layer_kernels,
+            ..SplatSettings::default()
+        };
+        let mut splatter = Splatter::new(&ctx, grid_fine(2.0), settings).unwrap();
+        let out = render(&mut splatter, &frame, VIEW);
+        assert_eq!(out.stats.layer_kernels, layer_kernels);
+        out.color
+    };
+    let (layers, levels) = (run(true), run(false));
+    let peak = 4.0f64;
+    let mse = layers
+        .iter()
+        .zip(&levels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (f64::from(a[c]) - f64::from(b[c])).powi(2)))
+        .sum::<f64>()
+        / (3 * layers.len()) as f64;
+    let db = 10.0 * (peak * peak / mse).log10();
+    eprintln!("layer kernels against the radius levels: {db:.2} dB (peak {peak})");
+    assert!(db > LAYERS_AGAINST_LEVELS_DB, "{db} dB");
+    common::finish(ctx);
+}
+
+/// Measured on lavapipe: 88.58 dB.
+const LAYERS_AGAINST_LEVELS_DB: f64 = 85.0;
 
 const SCENE_W: u32 = 160;
 const SCENE_H: u32 = 90;

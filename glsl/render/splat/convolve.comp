@@ -21,12 +21,15 @@
 #define FRAME_BINDING 12
 #define BANDS_BINDING 7
 #define ATLAS_BINDING 8
+#define LAYER_ATLAS_BINDING 13
 #include "splat.glsl"
 #include "band.glsl"
+#include "layer_atlas.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
+layout(binding = 14) uniform sampler3D layer_texture;
 FRAGMENT_BUFFERS(1, 9, 10, 11, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
@@ -43,6 +46,9 @@ layout(constant_id = 0) const uint TILE = 8u;
 // Off axis (a field lattice of more than one node): a pipeline of its own, so that the on-axis
 // convolution carries none of the four-node code.
 layout(constant_id = 1) const uint OFF_AXIS = 0u;
+// 1: each object distance's own kernel from the layer texture, one read for all channels
+// (frame.layered says the same; a pipeline of its own, so each carries only its reads).
+layout(constant_id = 3) const uint LAYERED = 0u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
@@ -81,6 +87,16 @@ vec3 kernel_rgb(vec2 d, float l, float index, uint node, uint size) {
 // (the usual case), the three lookups serve every channel, else each channel takes its own two.
 vec3 kernel_at(Fragment f, vec2 d, uint node) {
     uint size = block_size(f);
+    if (LAYERED != 0u) {
+        uint kind = layer_kind(size);
+        if (any(greaterThanEqual(abs(d), vec2(layer_bound(kind))))) {
+            return vec3(0.0);
+        }
+        vec3 extent = vec3(textureSize(layer_texture, 0));
+        vec3 uvw = vec3((vec2(layer_node_origin(node)) + layer_point(kind) + d) / extent.xy,
+                        (f.index + 0.5) / extent.z);
+        return textureLod(layer_texture, uvw, 0.0).rgb / layer_scale();
+    }
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
     vec3 t = level - lo;

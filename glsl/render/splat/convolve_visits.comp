@@ -17,12 +17,15 @@
 #define FRAME_BINDING 12
 #define BANDS_BINDING 7
 #define ATLAS_BINDING 8
+#define LAYER_ATLAS_BINDING 13
 #include "splat.glsl"
 #include "band.glsl"
+#include "layer_atlas.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
+layout(binding = 14) uniform sampler3D layer_texture;
 FRAGMENT_BUFFERS(1, 9, 10, 11, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
@@ -41,6 +44,9 @@ layout(constant_id = 0) const uint TILE = 8u;
 layout(constant_id = 1) const uint OFF_AXIS = 0u;
 // The seed paper's per-fragment blend (1) or depth groups (0); frame.blend_mode says the same.
 layout(constant_id = 2) const uint PER_FRAGMENT_BLEND = 0u;
+// 1: each object distance's own kernel from the layer texture: one read per visit, all
+// channels (a pipeline of its own: a CPU implementation pays for every read it contains).
+layout(constant_id = 3) const uint LAYERED = 0u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 const bool grouped = PER_FRAGMENT_BLEND == 0u;
@@ -131,6 +137,13 @@ ReadPlan plan_reads(Fragment f, float pre) {
         plan.coefs[i] = vec3(0.0);
     }
     plan.counts = uint[3](0u, 0u, 0u);
+    if (LAYERED != 0u) {
+        // One read of the distance's own kernel (fill_slot places it).
+        plan.coefs[0] = vec3(pre / layer_scale());
+        plan.counts[0] = 1u;
+        plan.slots = 1u;
+        return plan;
+    }
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
     vec3 t = level - lo;
@@ -160,10 +173,18 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
         bool used = i < plan.counts[s];
         uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
         coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
-        // A merged block of 4×4 and up reads its side's block-summed kernel (kernel_slot).
-        uint at = kernel_slot(l, block_size(f));
-        // An unused read stays harmless: its bound rejects every offset.
-        slot_read[READS * j + i] = vec4(slot_point(at), used ? slot_bound(at, l) : 0.0, coef[i].r);
+        if (LAYERED != 0u) {
+            // The layer texture's slot for this fragment's kind (plain or its block side).
+            uint kind = layer_kind(block_size(f));
+            slot_read[READS * j + i] =
+                vec4(layer_point(kind), used ? layer_bound(kind) : 0.0, coef[i].r);
+        } else {
+            // A merged block of 4×4 and up reads its side's block-summed kernel (kernel_slot).
+            uint at = kernel_slot(l, block_size(f));
+            // An unused read stays harmless: its bound rejects every offset.
+            slot_read[READS * j + i] =
+                vec4(slot_point(at), used ? slot_bound(at, l) : 0.0, coef[i].r);
+        }
     }
     slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
@@ -176,13 +197,17 @@ vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 ex
     // Past the block's zero ring lie other blocks: nothing counts there. An unused read's
     // bound is 0. (A GPU skips the read here; a CPU implementation reads and discards.)
     if (all(lessThan(abs(d), vec2(at.z)))) {
-        w = vec3(at.w, gb_r.xy)
-          * textureLod(psf_texture, vec3((node + at.xy + d) / extent, layer), 0.0).rgb;
+        vec3 uvw = vec3((node + at.xy + d) / extent, layer);
+        w = vec3(at.w, gb_r.xy) * (LAYERED != 0u ? textureLod(layer_texture, uvw, 0.0).rgb
+                                                 : textureLod(psf_texture, uvw, 0.0).rgb);
     }
     return w;
 }
 
 vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2 extent) {
+    if (LAYERED != 0u) {
+        return one_read(j, 0u, gb0.xyz, d, node, layer, extent);
+    }
     return one_read(j, 0u, gb0.xyz, d, node, layer, extent)
          + one_read(j, 1u, vec3(gb0.zw, 0.0), d, node, layer, extent)
          + one_read(j, 2u, gb1.xyz, d, node, layer, extent);
@@ -294,8 +319,12 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
                 uvec4 nodes;
                 vec4 weights;
                 field_corners(f.center, nodes, weights);
-                vec4 n01 = vec4(vec2(node_origin(nodes.x)), vec2(node_origin(nodes.y)));
-                vec4 n23 = vec4(vec2(node_origin(nodes.z)), vec2(node_origin(nodes.w)));
+                vec4 n01 = LAYERED != 0u
+                    ? vec4(vec2(layer_node_origin(nodes.x)), vec2(layer_node_origin(nodes.y)))
+                    : vec4(vec2(node_origin(nodes.x)), vec2(node_origin(nodes.y)));
+                vec4 n23 = LAYERED != 0u
+                    ? vec4(vec2(layer_node_origin(nodes.z)), vec2(layer_node_origin(nodes.w)))
+                    : vec4(vec2(node_origin(nodes.z)), vec2(node_origin(nodes.w)));
                 [[unroll]] for (uint k = 0u; k < 3u; k++) {
                     if (k < slots) {
                         slot_nodes[2u * (first + k)] = n01;
@@ -408,7 +437,8 @@ void main() {
         Gg[q] = vec3(0.0);
         last[q] = -1.0;
     }
-    walk_slots(n, base, ty, vec3(textureSize(psf_texture, 0)));
+    walk_slots(n, base, ty, vec3(LAYERED != 0u ? textureSize(layer_texture, 0)
+                                               : textureSize(psf_texture, 0)));
 
     [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
         close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);

@@ -277,6 +277,98 @@ impl TextureLayout {
     }
 }
 
+/// Where each object distance's own kernel lies in the layer texture
+/// (glsl/common/layer_atlas.glsl): one region per field node, and in it one slot per kind of
+/// fragment, side by side: the plain kernel ((2R+1)² texels inside a zero ring, R the grid's
+/// largest radius) and per block side s of `blocks` the block-summed one ((2R+s)² inside a
+/// ring). The layer is the object distance, as in the PSF texture.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct LayerLayout {
+    pub nodes: u32,
+    pub objects: u32,
+    /// R: every slot holds kernels up to this radius.
+    pub max_radius: u32,
+    pub region: [u32; 2],
+    pub columns: u32,
+    /// Per kind (0: plain, then the block sides 4, 8, 16, 32): the texel of its offset 0
+    /// within a region and its block side, if the texture holds it.
+    pub kinds: [Option<([u32; 2], u32)>; 5],
+}
+
+impl LayerLayout {
+    pub fn new(max_radius: u32, nodes: u32, objects: u32, blocks: &[BlockKernels]) -> LayerLayout {
+        let r = max_radius;
+        let mut kinds = [None; 5];
+        let mut x = 0;
+        let mut height = 0;
+        let sides = std::iter::once(0).chain(blocks.iter().map(|b| b.side));
+        for side in sides {
+            // A plain kernel's offset 0 is its centre texel, r + 1 from the slot's edge; a
+            // block's is the texel that begins at it, r + s/2 + 1 from the edge.
+            let (width, edge) = if side == 0 {
+                (2 * r + 3, r + 1)
+            } else {
+                (2 * r + side + 2, r + side / 2 + 1)
+            };
+            let kind = if side == 0 {
+                0
+            } else {
+                side.trailing_zeros() as usize - 1
+            };
+            kinds[kind] = Some(([x + edge, edge], side));
+            x += width;
+            height = height.max(width);
+        }
+        let columns = (1..=nodes)
+            .min_by_key(|&c| (c * x).max(nodes.div_ceil(c) * height))
+            .unwrap_or(1);
+        LayerLayout {
+            nodes,
+            objects,
+            max_radius,
+            region: [x, height],
+            columns,
+            kinds,
+        }
+    }
+
+    pub fn extent(&self) -> [u32; 3] {
+        let rows = self.nodes.div_ceil(self.columns);
+        [
+            self.columns * self.region[0],
+            rows * self.region[1],
+            self.objects,
+        ]
+    }
+
+    pub fn bytes(&self, texel_bytes: u64) -> u64 {
+        let [x, y, z] = self.extent();
+        u64::from(x) * u64::from(y) * u64::from(z) * texel_bytes
+    }
+
+    /// The LayerAtlas buffer: the region, regions per row and R; per kind its offset-0 texel,
+    /// block side and whether it is held.
+    pub fn words(&self) -> Vec<[u32; 4]> {
+        let mut words = vec![[
+            self.region[0],
+            self.region[1],
+            self.columns,
+            self.max_radius,
+        ]];
+        words.extend(self.kinds.iter().map(|k| match k {
+            Some((at, side)) => [at[0], at[1], *side, 1],
+            None => [0, 0, 0, 0],
+        }));
+        words
+    }
+
+    /// Whether this device can create the texture (every side within its 3D-image limit).
+    pub fn fits(&self, ctx: &Context) -> bool {
+        let [x, y, z] = self.extent();
+        x.max(y).max(z) <= ctx.limits().max_image_dimension3_d
+    }
+}
+
 /// Radius levels of a layout's slots (the plain ones come first, one per level).
 fn level_count_of(slots: &[Slot]) -> u32 {
     slots.iter().filter(|s| s.block_side == 0).count() as u32
@@ -434,5 +526,37 @@ mod tests {
         assert_eq!(field_texture_limit_bytes(GIB, GIB / 2), GIB / 2);
         // A small GPU gets the floor, not a quarter of its memory.
         assert_eq!(field_texture_limit_bytes(4 * GIB, 8 * GIB), 2 * GIB);
+    }
+
+    /// The layer texture's slots lie side by side within their region, each with its ring,
+    /// and a block kind's offset 0 sits where the convolution's bound expects it.
+    #[test]
+    fn layer_slots_fit_their_region() {
+        let blocks = [
+            BlockKernels {
+                side: 4,
+                first_level: 10,
+            },
+            BlockKernels {
+                side: 16,
+                first_level: 30,
+            },
+        ];
+        let l = LayerLayout::new(20, 1, 161, &blocks);
+        assert_eq!(l.kinds[0], Some(([21, 21], 0)));
+        // plain: 43 texels wide; then the 4-block: 46 wide, offset 0 at 20 + 2 + 1 = 23 in
+        assert_eq!(l.kinds[1], Some(([43 + 23, 23], 4)));
+        assert_eq!(l.kinds[2], None);
+        assert_eq!(l.kinds[3], Some(([43 + 46 + 29, 29], 16)));
+        assert_eq!(l.region, [43 + 46 + 58, 58]);
+        assert_eq!(l.extent(), [147, 58, 161]);
+        for (at, side) in l.kinds.iter().flatten() {
+            let half = 20 + side / 2 + 1;
+            assert!(at[0] >= half && at[1] >= half);
+            assert!(at[1] + half <= l.region[1] + u32::from(*side == 0));
+        }
+        let many = LayerLayout::new(20, 12, 161, &[]);
+        let [x, y, _] = many.extent();
+        assert!(x.max(y) <= 4 * 43, "{x}×{y}");
     }
 }

@@ -90,6 +90,19 @@ impl Splatter {
         let texture = psf_texture::create_texture(ctx, layout.extent(), settings.texture_format)?;
         let field_table = field::FieldTable::new(ctx, field_axes.as_ref(), grid.objects.count)?;
         let atlas = Buffer::from_slice(ctx, "PSF texture atlas", &layout.atlas_words())?;
+        // The layer kernels, on axis (off axis each node's kernel has its own radius, which
+        // the four-node mix would blend at different sizes).
+        let full =
+            atlas::LayerLayout::new(grid.max_radius_px, 1, grid.objects.count as u32, &blocks);
+        let layer_kernels = settings.layer_kernels && !off_axis && full.fits(ctx);
+        let layer_layout = if layer_kernels {
+            full
+        } else {
+            atlas::LayerLayout::new(0, 1, 1, &[])
+        };
+        let layer_texture =
+            psf_texture::create_texture(ctx, layer_layout.extent(), settings.texture_format)?;
+        let layer_atlas = Buffer::from_slice(ctx, "layer texture atlas", &layer_layout.words())?;
         let radii = Buffer::new(
             ctx,
             "object radii",
@@ -102,6 +115,10 @@ impl Splatter {
             resident,
             layout,
             atlas,
+            layer_layout,
+            layer_atlas,
+            layer_texture,
+            layer_kernels,
             field_table,
             node_grids,
             field_axes,

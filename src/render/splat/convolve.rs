@@ -9,6 +9,8 @@ use super::Resources;
 
 pub(super) struct ConvolvePass {
     pipeline: ComputePipeline,
+    /// On axis, the same walk reading the layer texture (one read per pixel and fragment).
+    layered: Option<ComputePipeline>,
 }
 
 impl super::passes::Pass for ConvolvePass {
@@ -17,21 +19,31 @@ impl super::passes::Pass for ConvolvePass {
     /// from the frame block); `visit_slots` picks the walk for CPU implementations
     /// (glsl/render/splat/convolve_visits.comp says why).
     fn new(ctx: &Context, config: &PassConfig) -> GpuResult<Self> {
-        let builder = if config.visit_slots {
-            ComputePipeline::builder(
-                "convolve",
-                crate::shaders::RENDER_SPLAT_CONVOLVE_VISITS_COMP,
-            )
-            .specialize(2, u32::from(config.per_fragment))
-        } else {
-            ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
+        let build = |layered: bool| {
+            let builder = if config.visit_slots {
+                ComputePipeline::builder(
+                    "convolve",
+                    crate::shaders::RENDER_SPLAT_CONVOLVE_VISITS_COMP,
+                )
+                .specialize(2, u32::from(config.per_fragment))
+            } else {
+                ComputePipeline::builder("convolve", crate::shaders::RENDER_SPLAT_CONVOLVE_COMP)
+            };
+            builder
+                .push_constants::<BandPush>()
+                .specialize(0, config.tile_size)
+                .specialize(1, u32::from(config.off_axis))
+                .specialize(3, u32::from(layered))
+                .build(ctx)
         };
-        let pipeline = builder
-            .push_constants::<BandPush>()
-            .specialize(0, config.tile_size)
-            .specialize(1, u32::from(config.off_axis))
-            .build(ctx)?;
-        Ok(ConvolvePass { pipeline })
+        Ok(ConvolvePass {
+            pipeline: build(false)?,
+            layered: if config.off_axis {
+                None
+            } else {
+                Some(build(true)?)
+            },
+        })
     }
 }
 
@@ -45,9 +57,15 @@ impl ConvolvePass {
         band: &BandSlot<'_>,
     ) -> GpuResult<()> {
         let table = &r.frame.band_table;
-        rec.compute(&self.pipeline)
+        let pipeline = match (&self.layered, r.block.values.layered) {
+            (Some(layered), 1) => layered,
+            _ => &self.pipeline,
+        };
+        rec.compute(pipeline)
             .read("psf_texture", (r.texture, r.sampler))
             .read("Atlas", r.atlas)
+            .read("layer_texture", (r.layer_texture, r.sampler))
+            .read("LayerAtlas", r.layer_atlas)
             .read("Field", r.field_table)
             .read("Fragments", &r.frame.fragments)
             .read("Counts", &r.frame.counts)

@@ -28,6 +28,7 @@ mod uniform;
 passes::passes! {
     input: input::InputPass,
     psf_texture: psf_texture::PsfTexturePass,
+    layer_kernels: layer_kernels::LayerKernelsPass,
     fragments: fragments::FragmentsPass,
     merge: merge::MergePass,
     tile_count: tile_count::TileCountPass,
@@ -129,6 +130,9 @@ pub struct SplatStats {
     pub readback_bytes: u64,
     /// Device memory of the PSF texture.
     pub psf_texture_bytes: u64,
+    /// Whether the convolution read each object distance's own kernel (the layer texture,
+    /// one read per pixel and fragment) rather than the radius levels.
+    pub layer_kernels: bool,
 }
 
 /// Intermediate buffers of a single-band frame, read back for tests.
@@ -187,6 +191,8 @@ struct Resources<'a> {
     texture: &'a Image,
     sampler: &'a Sampler,
     atlas: &'a Buffer,
+    layer_texture: &'a Image,
+    layer_atlas: &'a Buffer,
 }
 
 pub struct Splatter {
@@ -202,6 +208,14 @@ pub struct Splatter {
     layout: atlas::TextureLayout,
     /// The texture's layout for the shaders (glsl/common/atlas.glsl), written once.
     atlas: Buffer,
+    /// Each object distance's own kernel (`layer_kernels`): its layout, the layout for the
+    /// shaders (glsl/common/layer_atlas.glsl), the texture, and whether frames may use it (on
+    /// axis, `SplatSettings::layer_kernels`, within the device's limits; otherwise a 1-texel
+    /// stand-in the convolution binds but never reads).
+    layer_layout: atlas::LayerLayout,
+    layer_atlas: Buffer,
+    layer_texture: Image,
+    layer_kernels: bool,
     field_table: field::FieldTable,
     texture: Image,
     sampler: Sampler,
@@ -260,10 +274,25 @@ impl Splatter {
         (&self.texture, &self.sampler)
     }
 
-    /// Device memory of the PSF texture (bytes).
+    /// Device memory of the PSF texture and the layer texture (bytes).
     pub fn psf_texture_bytes(&self) -> u64 {
-        self.layout
-            .bytes(self.settings.texture_format.texel_bytes())
+        let texel = self.settings.texture_format.texel_bytes();
+        self.layout.bytes(texel) + self.layer_layout.bytes(texel)
+    }
+
+    /// Whether a frame with these per-object radii (xyz, px) reads the layer texture, and the
+    /// largest radius step between neighbouring object distances it must then reach past a
+    /// fragment's own radius: where that step is at most `LAYER_RADIUS_STEP_MAX_PX`.
+    fn layer_radius_step(&self, radii: &[[f32; 4]]) -> Option<f32> {
+        if !self.layer_kernels {
+            return None;
+        }
+        let most = self.grid.max_radius_px as f32;
+        let step = radii
+            .windows(2)
+            .flat_map(|w| (0..3).map(move |c| (w[1][c].min(most) - w[0][c].min(most)).abs()))
+            .fold(0.0f32, f32::max);
+        (step <= settings::LAYER_RADIUS_STEP_MAX_PX).then_some(step)
     }
 
     /// The texel at the centre of radius level `level`'s kernel of field node `node` (on axis
@@ -344,10 +373,12 @@ impl Splatter {
             height: h,
             fov_y_deg: shape.fov_y_deg,
         };
-        let params = self.params(
+        let mut params = self.params(
             self.frame.as_ref().expect("ensured above"),
             projection.focal_px() as f32,
         );
+        params.radius_step = self.layer_radius_step(&radii).unwrap_or(0.0);
+        params.layered = u32::from(self.layer_radius_step(&radii).is_some());
         // Through the persistent mapping: submissions complete before `submit` returns, so no
         // earlier frame still reads it.
         let frame_mut = self.frame.as_mut().expect("ensured above");
@@ -409,6 +440,7 @@ impl Splatter {
                     upload_bytes,
                     readback_bytes: output_bytes + bands::BAND_TABLE_HEADER_BYTES,
                     psf_texture_bytes: self.psf_texture_bytes(),
+                    layer_kernels: params.layered != 0,
                 };
                 let color: Vec<[f32; 4]> = frame.readback_color.read_mapped_all()?;
                 check_every_pixel_written(&color, w as usize)?;
@@ -515,6 +547,7 @@ impl Splatter {
             upload_bytes,
             readback_bytes: output_bytes + header_at + bands::BAND_TABLE_HEADER_BYTES,
             psf_texture_bytes: self.psf_texture_bytes(),
+            layer_kernels: params.layered != 0,
         };
         let intermediates = if keep_intermediates {
             let mut all_entries: Vec<[u32; 2]> = entries.read(&ctx)?;
@@ -567,6 +600,8 @@ impl Splatter {
             texture: &self.texture,
             sampler: &self.sampler,
             atlas: &self.atlas,
+            layer_texture: &self.layer_texture,
+            layer_atlas: &self.layer_atlas,
         }
     }
 
@@ -601,6 +636,14 @@ impl Splatter {
             self.passes
                 .psf_texture
                 .record(rec, r, &self.resident, blend, &blocks)?;
+            if r.block.values.layered != 0 {
+                rec.begin_pass("layer kernels");
+                // The slots' rings and the gaps between regions must read zero (see above).
+                rec.clear_image(&self.layer_texture, [0.0; 4]);
+                self.passes
+                    .layer_kernels
+                    .record(rec, r, &self.layer_layout)?;
+            }
         }
         rec.begin_pass("fragments");
         self.passes.fragments.record(rec, r, hidden)?;

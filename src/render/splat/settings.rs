@@ -85,7 +85,16 @@ pub struct SplatSettings {
     pub pupil_visibility: bool,
     /// How the convolution walks a tile's list (the same image either way).
     pub convolve_walk: ConvolveWalk,
+    /// Read each object distance's own kernel (one filtered read per pixel and fragment, all
+    /// channels) where neighbouring distances' radii differ by at most
+    /// [`LAYER_RADIUS_STEP_MAX_PX`], on axis; false: always the radius levels (up to three).
+    pub layer_kernels: bool,
 }
+
+/// Largest radius step (px) between neighbouring object distances at which the layer kernels
+/// are used: the filter between two distances then blends kernels whose edges lie at most this
+/// far apart, where the radius levels blend kernels a whole pixel apart (above 2 px).
+pub const LAYER_RADIUS_STEP_MAX_PX: f32 = 0.5;
 
 /// The convolution's two shapes (glsl/render/splat/convolve.comp and convolve_visits.comp):
 /// the same image, each fast on one kind of device.
@@ -123,6 +132,7 @@ impl Default for SplatSettings {
             saturation_epsilon: DEFAULT_SATURATION_EPSILON,
             steady_state: true,
             pupil_visibility: true,
+            layer_kernels: true,
             convolve_walk: ConvolveWalk::Auto,
         }
     }

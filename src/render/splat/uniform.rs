@@ -36,6 +36,10 @@ pub(crate) struct FrameUniform {
     pub fragments_per_chunk: u32,
     /// Depth layers stacked in the inputs and the fragment buffer (1 = the visible surface).
     pub layers: u32,
+    /// 1: the convolution reads the layer texture (`layer_kernels`), 0: the radius levels.
+    pub layered: u32,
+    /// Layered: the largest radius step (px) between neighbouring object distances; else 0.
+    pub radius_step: f32,
 }
 
 /// Bytes of frame uniforms a splat frame sends the device.
@@ -77,6 +81,8 @@ impl Splatter {
             saturation_epsilon: self.settings.saturation_epsilon,
             fragments_per_chunk: frame.fragments.per_chunk,
             layers: frame.layers,
+            layered: 0,
+            radius_step: 0.0,
         }
     }
 }

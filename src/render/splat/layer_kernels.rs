@@ -1,0 +1,70 @@
+//! Layer-kernels pass: each object distance's own kernel for this frame, from the PSF texture's
+//! radius levels, so that the convolution reads one texel for all channels. See
+//! glsl/render/splat/layer_kernels.comp.
+
+use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
+
+use super::atlas::LayerLayout;
+use super::Resources;
+
+shader_block! {
+    /// Push constants of one dispatch: a field node and a kind of slot. Mirrors
+    /// `LayerKernelsPush` in glsl/render/splat/layer_kernels.comp.
+    #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+    pub(super) struct LayerKernelsPush {
+        pub node: u32,
+        /// 0: plain; 1 … 4: blocks of side 4 … 32.
+        pub kind: u32,
+    }
+}
+
+pub(super) struct LayerKernelsPass {
+    pipeline: ComputePipeline,
+}
+
+impl super::passes::Pass for LayerKernelsPass {
+    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
+        let pipeline = ComputePipeline::builder(
+            "layer kernels",
+            crate::shaders::RENDER_SPLAT_LAYER_KERNELS_COMP,
+        )
+        .push_constants::<LayerKernelsPush>()
+        .build(ctx)?;
+        Ok(LayerKernelsPass { pipeline })
+    }
+}
+
+impl LayerKernelsPass {
+    /// Writes every node's slots of `layout` from the PSF texture, which must hold this
+    /// frame's blend.
+    pub fn record(
+        &self,
+        rec: &mut Recorder<'_>,
+        r: &Resources<'_>,
+        layout: &LayerLayout,
+    ) -> GpuResult<()> {
+        for node in 0..layout.nodes {
+            for (kind, slot) in layout.kinds.iter().enumerate() {
+                let Some((_, side)) = slot else { continue };
+                let width = if *side == 0 {
+                    2 * layout.max_radius + 3
+                } else {
+                    2 * layout.max_radius + side + 2
+                };
+                rec.compute(&self.pipeline)
+                    .read("psf_texture", (r.texture, r.sampler))
+                    .write("layer_texture", r.layer_texture)
+                    .read("Field", r.field_table)
+                    .read("Atlas", r.atlas)
+                    .read("LayerAtlas", r.layer_atlas)
+                    .read("FrameUniform", r.block.buffer)
+                    .push(&LayerKernelsPush {
+                        node,
+                        kind: kind as u32,
+                    })
+                    .dispatch([width.div_ceil(8), width.div_ceil(8), layout.objects])?;
+            }
+        }
+        Ok(())
+    }
+}
