@@ -168,7 +168,10 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
             .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
             .fold(0.0f32, f32::max);
         eprintln!("off axis: worst difference between the walks {worst:.2e}");
-        assert!(worst <= 1e-5, "the pixel walk differs off axis by {worst:e}");
+        assert!(
+            worst <= 1e-5,
+            "the pixel walk differs off axis by {worst:e}"
+        );
     }
     let refused = FrameRenderer::new(
         &ctx,
