@@ -5,7 +5,7 @@
 //! 720 px over a 30° field: the natural radii reach past 48 and are capped, as the paper's 48
 //! is at 720p), and a single-frame column of 123 PSFs. Eyes: the shipped `keratoconus` preset
 //! (estimated from the seed paper's measured keratoconus) and the hand-derived stand-ins of
-//! `eye::test_eyes`.
+//! `eye::hand_made_eyes`.
 
 use ocular::eye::file::resolve;
 use ocular::optics::fft_psf::{fft_cost, psf_by_fft};

@@ -96,7 +96,7 @@ pub fn resolve(spec: &str) -> crate::Result<EyeFile> {
         return Ok(f);
     }
     // The hand-made eyes of the kernel benchmarks are accepted too, but not advertised.
-    if let Some(eye) = super::test_eyes::test_eye(spec) {
+    if let Some(eye) = super::hand_made_eyes::hand_made_eye(spec) {
         return Ok(EyeFile {
             eye,
             estimate: None,

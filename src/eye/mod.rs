@@ -10,6 +10,7 @@ pub mod estimate;
 pub mod field;
 pub mod file;
 pub mod fit;
+pub mod hand_made_eyes;
 pub mod lens;
 pub mod measure;
 pub mod media;
@@ -20,7 +21,6 @@ pub mod refract;
 pub mod show;
 pub mod surface;
 pub mod system;
-pub mod test_eyes;
 pub mod trace;
 
 pub use accommodate::{accommodate, focus_within_range, Accommodation, FocusLimit, Focused};

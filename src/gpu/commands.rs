@@ -12,12 +12,16 @@ use super::pipeline::{Binding, ComputePipeline, PipelineParts};
 use super::reflect::BindingKind;
 use super::submit_slot::{SubmitSlot, MAX_TIMED_PASSES, SETS_PER_POOL};
 
-/// GPU time of each named pass of one submission, in recording order.
+/// GPU time of each timed pass of one submission, in recording order. A timed pass is a
+/// timestamp label, the span from [`Recorder::begin_pass`] to the next `begin_pass` or
+/// `end_pass`: it may cover several pipelines, copies or a Vulkan render pass, and is neither a
+/// pipeline nor a `vk::RenderPass` (those are `begin_render_pass`'s, `render_pass.rs`).
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct Timings {
     pub passes: Vec<PassTime>,
 }
 
+/// One timed pass: its label and its GPU time.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct PassTime {
     pub name: String,
@@ -203,7 +207,8 @@ impl<'a> Recorder<'a> {
         self.ctx
     }
 
-    /// Starts timing a named pass; it ends at `end_pass` or at the next `begin_pass`.
+    /// Starts timing a named pass (a timestamp label over whatever is recorded next, not a
+    /// Vulkan render pass); it ends at `end_pass` or at the next `begin_pass`.
     pub fn begin_pass(&mut self, name: &str) {
         if self.open_pass.is_some() {
             self.end_pass();

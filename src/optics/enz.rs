@@ -415,8 +415,8 @@ pub fn lagrange6(t: f64) -> [f64; 6] {
     w
 }
 
-/// Radial step that keeps six-point Lagrange interpolation of a field band-limited to one cycle
-/// per unit r (every V_n^m is) within `tol` relative to its maximum. Error ≈ 5e-3 (2πh)^6.
+/// Radial step that keeps six-point Lagrange interpolation of an amplitude band-limited to one
+/// cycle per unit r (every V_n^m is) within `tol` relative to its maximum. Error ≈ 5e-3 (2πh)^6.
 pub fn interpolation_step(tol: f64) -> f64 {
     let tol = tol.clamp(1e-14, 1e-1);
     ((tol / 5e-3).powf(1.0 / 6.0) / (2.0 * PI)).min(0.25)

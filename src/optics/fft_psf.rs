@@ -3,7 +3,7 @@
 //! keratoconus at large pupils), whose cost does not grow with the size of the aberration but
 //! only with the grid.
 //!
-//! Same field and orientation as [`super::psf`]: U(x, y) = (1/π)∫∫ P e^{ifρ²}
+//! Same amplitude and orientation as [`super::psf`]: U(x, y) = (1/π)∫∫ P e^{ifρ²}
 //! e^{i2π(xρcosθ + yρsinθ)} d²ρ, (x, y) in λ/NA, row 0 at +y, the optical axis at the centre
 //! sample, 1 = the unaberrated in-focus peak.
 //!
@@ -96,7 +96,7 @@ pub fn psf_by_fft(
     let half = (size / 2) as i64;
     let a_max = (1.0 / du + 1.0).floor() as i64;
     let k2pi = 2.0 * PI / (wavelength_nm * 1e-3);
-    // single precision: the field's rounding (~1e-7 of the peak amplitude) is far below
+    // single precision: the amplitude's rounding (~1e-7 of its peak) is far below
     // anything a kernel (stored as f32) can show
     let plan = FftPlanner::<f32>::new().plan_fft_inverse(n);
     let mut scratch = vec![Complex32::default(); plan.get_inplace_scratch_len()];

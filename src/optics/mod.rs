@@ -6,14 +6,16 @@
 //! - [`quadrature`]: Gauss–Legendre, Fejér (cosine-sampled pupil) rules.
 //! - [`enz`]: V_n^m(r, f) (Bessel–Bessel series, power series, quadrature) and radial tables.
 //! - [`beta`]: ENZ pupil coefficients β from wavefront coefficients α.
+//! - [`amplitude`]: the ENZ amplitude U (the optical field) of one pupil at one defocus, on
+//!   grids: per-order radial coefficients and interpolation tables.
 //! - [`fft_psf`]: the PSF by FFT of the sampled pupil function (large aberrations).
 //! - [`psf`]: the high-level PSF entry point ([`psf::PsfRequest`] → [`psf::Psf`]).
 
+pub mod amplitude;
 pub mod bessel;
 pub mod beta;
 pub mod enz;
 pub mod fft_psf;
-pub mod field;
 pub mod prescription;
 pub mod psf;
 pub mod pupil;

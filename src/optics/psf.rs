@@ -1,10 +1,11 @@
-//! High-level PSF computation: Zernike wavefront → ENZ field → intensity on a Cartesian grid.
+//! High-level PSF computation: Zernike wavefront → ENZ amplitude → intensity on a Cartesian grid.
 //!
 //! # Geometry and orientation
-//! The field is U(x, y) = (1/π)∫∫ P(ρ, θ) e^{ifρ²} e^{i2π(xρcosθ + yρsinθ)} ρ dρ dθ with (x, y) in
-//! units of λ/NA and P the pupil function in the Zernike pupil axes (θ counter-clockwise from
-//! +x). Its ENZ form is U = 2 Σ β_nm √(n+1) i^m V_nm(r, f) e^{imφ}. The unaberrated in-focus
-//! peak is U(0, 0) = 1, so intensities are in units of the diffraction-limited peak.
+//! The amplitude (the optical field) is
+//! U(x, y) = (1/π)∫∫ P(ρ, θ) e^{ifρ²} e^{i2π(xρcosθ + yρsinθ)} ρ dρ dθ with (x, y) in units of
+//! λ/NA and P the pupil function in the Zernike pupil axes (θ counter-clockwise from +x). Its
+//! ENZ form is U = 2 Σ β_nm √(n+1) i^m V_nm(r, f) e^{imφ}. The unaberrated in-focus peak is
+//! U(0, 0) = 1, so intensities are in units of the diffraction-limited peak.
 //!
 //! The output grid is row-major, `size × size`, with the optical axis at pixel
 //! (col, row) = (size/2, size/2) (0-based), x = (col − size/2)·pitch to the right and
@@ -15,20 +16,20 @@
 //! towards row 0). Tested in tests/it/optics_psf.rs.
 //!
 //! # Accuracy
-//! The β expansion misses a fraction `beta_tolerance` of the pupil energy; the field error
+//! The β expansion misses a fraction `beta_tolerance` of the pupil energy; the amplitude error
 //! that causes is spread over the PSF, so relative to the peak of a strongly blurred PSF (peak
 //! ≪ 1) it is larger, roughly sqrt(tolerance/peak). The default 1e-8 keeps 1 D–10 D defocused
 //! PSFs within ~1e-4 of their peak. Radial interpolation adds `radial_tolerance` (relative to
-//! the field maximum).
+//! the amplitude maximum).
 //!
 //! # Defocus, tilt and piston
 //! c(2,0) is carried by f (f = 4√3·π·c(2,0)/λ added to the requested f), never by β; tilt is an
-//! exact translation of the field, so it is applied by shifting the evaluation grid (or dropped
+//! exact translation of the amplitude, so it is applied by shifting the evaluation grid (or dropped
 //! with `include_tilt = false`); piston is a global phase.
 
+use super::amplitude::{AmplitudeTable, Block8, LagrangeRule, RadialAmplitude};
 use super::beta::{beta_from_alpha, BetaExpansion, StilesCrawford};
 use super::enz::MAX_ABS_F;
-use super::field::{Block8, FieldTable, LagrangeRule, RadialField};
 use super::quadrature::fejer1_01;
 use super::zernike::{is_valid_nm, num_terms, osa_index};
 use super::{check_range, OpticsError};
@@ -63,7 +64,7 @@ pub struct PsfRequest {
     pub stiles_crawford: Option<StilesCrawford>,
     /// Apply tilt as a translation (true) or drop it, centring the PSF (false).
     pub include_tilt: bool,
-    /// Relative accuracy of the radial interpolation of the field tables.
+    /// Relative accuracy of the radial interpolation of the amplitude tables.
     pub radial_tolerance: f64,
     /// Lagrange taps for the radial tables (even, 4–20); `None` picks the cheapest order that
     /// meets `radial_tolerance`.
@@ -302,12 +303,12 @@ pub fn ideal_peak(stiles_crawford: Option<StilesCrawford>, pupil_diameter_mm: f6
 }
 
 /// Intensity on the request's grid. Without a tilt shift the grid is symmetric about the
-/// axis and has far fewer distinct radii than pixels: the field is then evaluated exactly at
+/// axis and has far fewer distinct radii than pixels: the amplitude is then evaluated exactly at
 /// each distinct radius. Otherwise (or when a table is cheaper) the radial values are tabulated
 /// and interpolated, with the interpolation order chosen by a cost model. Returns (intensity,
 /// step (0 = exact), taps (0 = exact), radial evaluations, time after the radial stage).
 fn synthesize(
-    rf: &RadialField,
+    rf: &RadialAmplitude,
     req: &PsfRequest,
     shift: (f64, f64),
 ) -> (Vec<f64>, f64, usize, usize, Instant) {
@@ -408,7 +409,7 @@ fn synthesize(
         );
         (intensity, 0.0, 0, keys.len(), t2)
     } else {
-        let table = FieldTable::new(rf, r_max, rule, step, req.parallel);
+        let table = AmplitudeTable::new(rf, r_max, rule, step, req.parallel);
         let t2 = Instant::now();
         if centred {
             let radial = |a: i64, b: i64, out: &mut [Complex64]| {
@@ -478,7 +479,7 @@ fn symmetric_fill(
             if !radial(a, b, &mut g) {
                 continue;
             }
-            let u = RadialField::quad_sums(&g, degree, a as f64 * pitch, b as f64 * pitch);
+            let u = RadialAmplitude::quad_sums(&g, degree, a as f64 * pitch, b as f64 * pitch);
             // u: (a, b), (−a, −b), (a, −b), (−a, b)
             let put = |row: &mut [f64], aa: i64, v: Complex64| {
                 if (lo..=hi).contains(&aa) {
@@ -583,7 +584,7 @@ pub fn psf_from_pupil(pupil: &Pupil, req: &PsfRequest) -> Result<Psf, OpticsErro
     let be = &pupil.beta;
     let t1 = Instant::now();
     let n = req.size;
-    let rf = RadialField::new(&be.beta, be.degree, f);
+    let rf = RadialAmplitude::new(&be.beta, be.degree, f);
     let t1b = Instant::now();
     let (intensity, radial_step, radial_taps, radial_nodes, t2) =
         synthesize(&rf, req, pupil.tilt_shift);

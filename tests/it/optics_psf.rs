@@ -432,8 +432,8 @@ fn behind_and_in_front_of_focus_differ_with_spherical_aberration() {
 fn radial_interpolation_holds_1e_6() {
     // A tilt forces the tabulated path (no symmetric grid); compare every pixel with the exact
     // point evaluation of the same field. Intensity error ≈ 2|U|·field error ≤ ~2e-6 of peak.
+    use ocular::optics::amplitude::RadialAmplitude;
     use ocular::optics::beta::beta_from_alpha;
-    use ocular::optics::field::RadialField;
     use ocular::optics::psf::split_wavefront;
     for (f, pitch) in [(0.0, 0.3), (60.0, 0.9), (-300.0, 3.7)] {
         let coeffs = vec![(1, 1, 0.3), (3, -1, 0.15), (4, 0, 0.1), (3, 3, 0.05)];
@@ -443,7 +443,7 @@ fn radial_interpolation_holds_1e_6() {
         assert!(psf.radial_taps > 0, "table path expected");
         let split = split_wavefront(&coeffs, 550.0, f, true);
         let be = beta_from_alpha(&split.alpha_um, 550.0, 5.0, None, req.beta_tolerance, 160);
-        let rf = RadialField::new(&be.beta, be.degree, split.f);
+        let rf = RadialAmplitude::new(&be.beta, be.degree, split.f);
         let n = req.size;
         let half = (n / 2) as f64;
         let mut worst: f64 = 0.0;
@@ -472,8 +472,8 @@ fn radial_interpolation_holds_1e_6() {
 fn centred_grids_match_pointwise_field() {
     // Without tilt the grid is filled four mirror images at a time (exact radii or table);
     // every pixel must still equal the field evaluated at that point, for even and odd sizes.
+    use ocular::optics::amplitude::RadialAmplitude;
     use ocular::optics::beta::beta_from_alpha;
-    use ocular::optics::field::RadialField;
     use ocular::optics::psf::split_wavefront;
     let coeffs = vec![
         (2, -2, 0.2),
@@ -488,7 +488,7 @@ fn centred_grids_match_pointwise_field() {
         let psf = compute_psf(&req).unwrap();
         let split = split_wavefront(&coeffs, 550.0, f, true);
         let be = beta_from_alpha(&split.alpha_um, 550.0, 5.0, None, req.beta_tolerance, 160);
-        let rf = RadialField::new(&be.beta, be.degree, split.f);
+        let rf = RadialAmplitude::new(&be.beta, be.degree, split.f);
         let half = (size / 2) as f64;
         let mut worst: f64 = 0.0;
         for row in 0..size {

@@ -224,7 +224,10 @@ fn nearer_and_farther_than_focus_differ_once_the_pupil_is_asymmetric() {
 #[test]
 fn defocus_parameter_matches_a_direct_measurement() {
     let settings = KernelSettings::default();
-    for eye in [Eye::navarro(), ocular::eye::test_eyes::keratoconus_like()] {
+    for eye in [
+        Eye::navarro(),
+        ocular::eye::hand_made_eyes::keratoconus_like(),
+    ] {
         let pupil = 5.0;
         // within reach of both (the keratoconus-like eye is about 3 D myopic)
         let focus_d = 5.0;
@@ -436,7 +439,7 @@ fn extreme_settings_give_finite_kernels_or_clear_errors() {
         ("focus 0.1 m", Eye::navarro(), 4.0, 10.0, WL),
         (
             "-10 D eye",
-            ocular::eye::test_eyes::test_eye("myopia10-like").unwrap(),
+            ocular::eye::hand_made_eyes::hand_made_eye("myopia10-like").unwrap(),
             4.0,
             0.0,
             WL,

@@ -1,4 +1,5 @@
-//! The ENZ field of one pupil at one defocus, organised for fast synthesis on grids.
+//! The ENZ amplitude (the complex optical field U, whose squared modulus is the PSF) of one
+//! pupil at one defocus, organised for fast synthesis on grids.
 //!
 //! U(r, φ) = 2 Σ_m i^m e^{imφ} Σ_n β_nm √(n+1) V_nm(r, f). For each azimuthal order m the
 //! inner sum is one Bessel–Bessel series G_m(r) = Σ_l D_ml J_{|m|+2l+1}(2πr)/(2πr) whose
@@ -19,7 +20,7 @@ struct Combo {
     dim: Vec<f64>,
 }
 
-/// Reusable buffers for [`RadialField::eval_radii`].
+/// Reusable buffers for [`RadialAmplitude::eval_radii`].
 #[derive(Default)]
 pub struct Block8 {
     radii: [Scratch; 8],
@@ -27,7 +28,7 @@ pub struct Block8 {
     even: Vec<f64>,
 }
 
-/// Reusable buffers for [`RadialField::eval_radius`].
+/// Reusable buffers for [`RadialAmplitude::eval_radius`].
 #[derive(Default)]
 pub struct Scratch {
     jbuf: Vec<f64>,
@@ -37,7 +38,7 @@ pub struct Scratch {
 }
 
 /// Per-m Bessel–Bessel coefficients of one pupil at one f.
-pub struct RadialField {
+pub struct RadialAmplitude {
     pub f: f64,
     pub degree: u32,
     combos: Vec<Combo>,
@@ -70,11 +71,11 @@ fn dot2(a: &[f64], b: &[f64], c: &[f64]) -> (f64, f64) {
     (ra, rb)
 }
 
-impl RadialField {
+impl RadialAmplitude {
     /// Coefficients for β (OSA order, orders ≤ `degree`) at defocus f. Combination index c:
     /// 0 → m = 0; 2μ−1 → m = +μ; 2μ → m = −μ. The factor 2·i^m and the parity of V for
     /// negative m are folded in, so U = Σ_c G_c(r) e^{i m_c φ}.
-    pub fn new(beta: &[Complex64], degree: u32, f: f64) -> RadialField {
+    pub fn new(beta: &[Complex64], degree: u32, f: f64) -> RadialAmplitude {
         let w = defocus_weights(f);
         let c_count = 2 * degree as usize + 1;
         let mut combos = Vec::with_capacity(c_count);
@@ -139,7 +140,7 @@ impl RadialField {
                 dim: d.iter().map(|v| v.im).collect(),
             });
         }
-        RadialField {
+        RadialAmplitude {
             f,
             degree,
             combos,
@@ -147,7 +148,7 @@ impl RadialField {
         }
     }
 
-    /// Floating-point work of one [`RadialField::eval_radius`] beyond the Bessel sequence
+    /// Floating-point work of one [`RadialAmplitude::eval_radius`] beyond the Bessel sequence
     /// (for choosing between tabulation strategies).
     pub fn work_per_radius(&self) -> usize {
         self.combos.iter().map(|c| 4 * c.dre.len()).sum::<usize>() + 3 * self.nu_max
@@ -177,7 +178,7 @@ impl RadialField {
         }
     }
 
-    /// [`RadialField::eval_radius`] for eight radii at once. The Bessel values of the eight
+    /// [`RadialAmplitude::eval_radius`] for eight radii at once. The Bessel values of the eight
     /// radii are interleaved so that each coefficient D_l is loaded once and multiplies a
     /// contiguous group of eight: the inner loop vectorises and the coefficients stream from
     /// memory once per eight radii. `out` holds 8·combos() values, radius-major.
@@ -256,10 +257,10 @@ impl RadialField {
         acc
     }
 
-    /// The field at the four mirror images (x, y), (−x, −y), (x, −y), (−x, y) of one point,
+    /// The amplitude at the four mirror images (x, y), (−x, −y), (x, −y), (−x, y) of one point,
     /// from the radial values g they share. With E_μ = e^{iμφ}: a half turn multiplies E_μ by
     /// (−1)^μ and a mirror in x conjugates it, so four partial sums (even/odd μ, E or Ē on
-    /// the m > 0 part) give all four fields for about half the work of two angular sums.
+    /// the m > 0 part) give all four amplitudes for about half the work of two angular sums.
     #[inline]
     pub fn quad_sums(g: &[Complex64], degree: u32, x: f64, y: f64) -> [Complex64; 4] {
         let r = x.hypot(y);
@@ -287,7 +288,7 @@ impl RadialField {
         [p[0] + p[1], p[0] - p[1], q[0] + q[1], q[0] - q[1]]
     }
 
-    /// Exact field at one point (x, y) in λ/NA.
+    /// Exact amplitude at one point (x, y) in λ/NA.
     pub fn at(&self, x: f64, y: f64) -> Complex64 {
         let mut s = Scratch::default();
         let mut g = vec![Complex64::default(); self.combos()];
@@ -303,8 +304,8 @@ pub struct LagrangeRule {
     pub taps: usize,
     offsets: Vec<f64>,
     denominators: Vec<f64>,
-    /// max over t ∈ [0,1] of Π|t − o_j| / T!: error ≈ this · (2πh)^T for a field band-limited
-    /// to one cycle per unit r (every ENZ field is).
+    /// max over t ∈ [0,1] of Π|t − o_j| / T!: error ≈ this · (2πh)^T for an amplitude
+    /// band-limited to one cycle per unit r (every ENZ amplitude is).
     pub error_constant: f64,
 }
 
@@ -336,7 +337,7 @@ impl LagrangeRule {
         }
     }
 
-    /// Node spacing that keeps the interpolation error below `tol` (relative to the field's
+    /// Node spacing that keeps the interpolation error below `tol` (relative to the amplitude's
     /// maximum), never above 0.45 (the Nyquist spacing is 0.5).
     pub fn step_for(&self, tol: f64) -> f64 {
         let x = (tol.clamp(1e-15, 1e-1) / self.error_constant).powf(1.0 / self.taps as f64);
@@ -373,7 +374,7 @@ impl LagrangeRule {
 
 /// G_c(r) tabulated at r_k = (k − g)·step, g ghost nodes below 0 filled by the parity
 /// G(−r) = (−1)^μ G(r), read by Lagrange interpolation.
-pub struct FieldTable {
+pub struct AmplitudeTable {
     pub step: f64,
     pub degree: u32,
     pub rule: LagrangeRule,
@@ -382,14 +383,14 @@ pub struct FieldTable {
     table: Vec<Complex64>,
 }
 
-impl FieldTable {
+impl AmplitudeTable {
     pub fn new(
-        rf: &RadialField,
+        rf: &RadialAmplitude,
         r_max: f64,
         rule: LagrangeRule,
         step: f64,
         parallel: bool,
-    ) -> FieldTable {
+    ) -> AmplitudeTable {
         let c_count = rf.combos();
         let ghosts = rule.ghosts();
         let nodes = (r_max / step).ceil() as usize + rule.taps + ghosts + 1;
@@ -425,7 +426,7 @@ impl FieldTable {
                 fill(k, rows, &mut s);
             }
         }
-        FieldTable {
+        AmplitudeTable {
             step,
             degree: rf.degree,
             rule,
@@ -465,12 +466,12 @@ impl FieldTable {
         true
     }
 
-    /// Interpolated field at (x, y); 0 beyond the table. `g` is scratch of length ≥ 2·degree+1.
+    /// Interpolated amplitude at (x, y); 0 beyond the table. `g` is scratch of length ≥ 2·degree+1.
     #[inline]
     pub fn at(&self, x: f64, y: f64, g: &mut [Complex64]) -> Complex64 {
         if !self.radial(x.hypot(y), g) {
             return Complex64::default();
         }
-        RadialField::angular_sum(g, self.degree, x, y)
+        RadialAmplitude::angular_sum(g, self.degree, x, y)
     }
 }

@@ -1,14 +1,16 @@
-//! Hand-derived test eyes standing in for the seed paper's estimated presets until eye
-//! estimation provides them: Navarro's eye made myopic by a longer axis, and a
-//! keratoconus-like eye (steep, toric, irregular cornea). Not fits to any measurement.
+//! Hand-made eyes, derived by hand rather than fitted to any measurement: Navarro's eye made
+//! myopic by a longer axis, and a keratoconus-like eye (steep, toric, irregular cornea). They
+//! stood in for the seed paper's estimated presets until eye estimation provided them, and are
+//! still accepted wherever an eye is named (`eye::file::resolve`, not listed as presets) and
+//! used by the kernel benchmarks and tests.
 
 use super::model::{ElevationTerm, Eye};
 
-/// Names accepted by [`test_eye`].
-pub const TEST_EYE_NAMES: [&str; 3] = ["myopia-like", "keratoconus-like", "myopia10-like"];
+/// Names accepted by [`hand_made_eye`].
+pub const HAND_MADE_EYE_NAMES: [&str; 3] = ["myopia-like", "keratoconus-like", "myopia10-like"];
 
-/// A test eye by name.
-pub fn test_eye(name: &str) -> Option<Eye> {
+/// A hand-made eye by name.
+pub fn hand_made_eye(name: &str) -> Option<Eye> {
     match name {
         "myopia-like" => Some(axial_myopia(2.2)),
         "myopia10-like" => Some(axial_myopia(3.7)),
@@ -58,14 +60,14 @@ mod tests {
     }
 
     #[test]
-    fn test_eyes_have_the_intended_errors() {
-        let (m, _, _) = refraction(&test_eye("myopia-like").unwrap(), 4.0);
+    fn hand_made_eyes_have_the_intended_errors() {
+        let (m, _, _) = refraction(&hand_made_eye("myopia-like").unwrap(), 4.0);
         assert!((-7.0..=-5.5).contains(&m), "myopia-like: {m} D");
-        let (m, _, _) = refraction(&test_eye("myopia10-like").unwrap(), 4.0);
+        let (m, _, _) = refraction(&hand_made_eye("myopia10-like").unwrap(), 4.0);
         assert!((-11.0..=-9.0).contains(&m), "myopia10-like: {m} D");
         // the seed paper's keratoconus preset (5 mm): coma ≈ 0.6 µm, astigmatism ≈ 0.3 µm,
         // about −3 D
-        let (m, coma, astig) = refraction(&test_eye("keratoconus-like").unwrap(), 5.0);
+        let (m, coma, astig) = refraction(&hand_made_eye("keratoconus-like").unwrap(), 5.0);
         assert!((-4.5..=-2.0).contains(&m), "keratoconus-like: {m} D");
         assert!((0.4..=1.0).contains(&coma), "coma {coma} µm");
         assert!((0.15..=0.6).contains(&astig), "astigmatism {astig} µm");
