@@ -1,12 +1,12 @@
 //! Tiled PSF splatting on the GPU (Csoba & Kunkli 2021, after Franke et al. 2018).
 //!
-//! Per frame: PSF texture (blend the kernel grid over pupil and focus) → fragments (one per
-//! pixel) → merge (optional 2×2 / 4×4 blocks) → tile count → prefix sum → band plan → [per
-//! band of tile rows: fill → sort → convolve]. List memory is exact (count → prefix sum →
-//! fill); when a frame's lists exceed the list buffer (the device's storage-buffer binding
-//! limit or the memory budget), the screen is processed in bands of tile rows, planned on the
-//! GPU from the prefix sum, so nothing is ever dropped and a banded frame is still one
-//! submission.
+//! Per frame: PSF texture (blend the kernel grid over pupil and focus; then, where neighbouring
+//! object distances' radii are close, each distance's own kernel: layer kernels) → fragments (one
+//! per pixel) → merge (optional 2×2 / 4×4 blocks) → tile count → prefix sum → band plan → [per band
+//! of tile rows: fill → sort → convolve]. List memory is exact (count → prefix sum → fill); when a
+//! frame's lists exceed the list buffer (the device's storage-buffer binding limit or the memory
+//! budget), the screen is processed in bands of tile rows, planned on the GPU from the prefix sum,
+//! so nothing is ever dropped and a banded frame is still one submission.
 //!
 //! Each pass is one file here plus `glsl/render/splat/<same stem>.comp`, listed once in `passes!`
 //! below (`passes` says how to add one); `construct` builds a splatter, `settings` holds its
