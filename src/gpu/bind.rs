@@ -432,7 +432,7 @@ mod tests {
         );
         let short = error_of(bind().read("FrameUniform", &small));
         assert!(
-            short.contains("uniform block \"FrameUniform\" is 80 bytes, buffer \"small\" binds 64"),
+            short.contains("uniform block \"FrameUniform\" is 88 bytes, buffer \"small\" binds 64"),
             "{short}"
         );
         drop((count, buffer, small));

@@ -425,11 +425,13 @@ mod tests {
                 (10, "Fragments2", StorageBuffer, Read),
                 (11, "Fragments3", StorageBuffer, Read),
                 (12, "FrameUniform", UniformBuffer, Read),
+                (13, "LayerAtlas", StorageBuffer, Read),
+                (14, "layer_texture", SampledImage, Read),
             ]
         );
-        // the frame block: 20 four-byte scalars, std140-packed like repr(C)
+        // the frame block: 22 four-byte scalars, std140-packed like repr(C)
         let frame = r.bindings[12].block.as_ref().unwrap();
-        assert_eq!(frame.bytes, 80);
+        assert_eq!(frame.bytes, 88);
         assert_eq!(frame.members[13], ("focal_px".to_string(), 52));
         assert!(r.bindings[11].block.is_none());
         // Merge reads and writes its fragments; tile count reads them and updates counts.

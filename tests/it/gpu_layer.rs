@@ -482,22 +482,22 @@ fn barriers_follow_declared_access_and_declarations_match_shaders() {
         .to_string();
     assert!(too_few.contains("uses binding 2"), "{too_few}");
     // A uniform block is checked against the struct declared for it: the tile-count pass's
-    // frame block (binding 5, after five fragment and count buffers) is 20 four-byte scalars.
+    // frame block (binding 5, after five fragment and count buffers) is 22 four-byte scalars.
     let tile_count = |uniform_bytes: usize| {
         let builder =
             ComputePipeline::builder("tile count", ocular::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
                 .bindings(&[BindingKind::StorageBuffer; 5]);
         match uniform_bytes {
-            80 => builder.uniform::<[u32; 20]>(),
+            88 => builder.uniform::<[u32; 22]>(),
             _ => builder.uniform::<[u32; 16]>(),
         }
         .build(&ctx)
     };
-    assert!(tile_count(80).is_ok());
+    assert!(tile_count(88).is_ok());
     let wrong_uniform = tile_count(64).err().expect("refused").to_string();
     assert!(
         wrong_uniform
-            .contains("uniform block at binding 5 is 80 bytes in the shader, the pass's struct 64"),
+            .contains("uniform block at binding 5 is 88 bytes in the shader, the pass's struct 64"),
         "{wrong_uniform}"
     );
     drop((probe, buffers, image, sampler));

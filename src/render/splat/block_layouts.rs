@@ -38,6 +38,8 @@ fn frame_uniform() -> BlockLayout {
         saturation_epsilon,
         fragments_per_chunk,
         layers,
+        layered,
+        radius_step,
     })
 }
 

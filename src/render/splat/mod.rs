@@ -282,16 +282,27 @@ impl Splatter {
 
     /// Whether a frame with these per-object radii (xyz, px) reads the layer texture, and the
     /// largest radius step between neighbouring object distances it must then reach past a
-    /// fragment's own radius: where that step is at most `LAYER_RADIUS_STEP_MAX_PX`.
+    /// fragment's own radius: where every step is at most `LAYER_RADIUS_STEP_MAX_PX` and no
+    /// coarser than the radius levels the layer kernels replace (neighbours within one level:
+    /// ¼ px below 2 px). Near focus a kernel's shape changes fastest, and there a coarser step
+    /// measurably lost to the levels (validation.md, "Layer kernels").
     fn layer_radius_step(&self, radii: &[[f32; 4]]) -> Option<f32> {
         if !self.layer_kernels {
             return None;
         }
         let most = self.grid.max_radius_px as f32;
-        let step = radii
-            .windows(2)
-            .flat_map(|w| (0..3).map(move |c| (w[1][c].min(most) - w[0][c].min(most)).abs()))
-            .fold(0.0f32, f32::max);
+        let mut step = 0.0f32;
+        for w in radii.windows(2) {
+            for c in 0..3 {
+                let (a, b) = (w[0][c].min(most), w[1][c].min(most));
+                let levels = crate::psf::kernels::level_of_radius(f64::from(a))
+                    - crate::psf::kernels::level_of_radius(f64::from(b));
+                if levels.abs() > 1.0 {
+                    return None;
+                }
+                step = step.max((b - a).abs());
+            }
+        }
         (step <= settings::LAYER_RADIUS_STEP_MAX_PX).then_some(step)
     }
 
