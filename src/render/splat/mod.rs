@@ -293,8 +293,8 @@ impl Splatter {
         let most = self.grid.max_radius_px as f32;
         let mut step = 0.0f32;
         for w in radii.windows(2) {
-            for c in 0..3 {
-                let (a, b) = (w[0][c].min(most), w[1][c].min(most));
+            for (&a, &b) in w[0][..3].iter().zip(&w[1][..3]) {
+                let (a, b) = (a.min(most), b.min(most));
                 let levels = crate::psf::kernels::level_of_radius(f64::from(a))
                     - crate::psf::kernels::level_of_radius(f64::from(b));
                 if levels.abs() > 1.0 {
