@@ -173,13 +173,7 @@ impl TextureLayout {
             .min_by_key(|&&(w, h)| (w.max(h), w))
             .map_or(widest, |p| p.0);
         let height = pack_slots(&mut slots, best);
-        // Regions per row: the arrangement closest to square.
-        let columns = (1..=nodes)
-            .min_by_key(|&c| {
-                let rows = nodes.div_ceil(c);
-                (c * best).max(rows * height)
-            })
-            .unwrap_or(1);
+        let columns = square_columns(nodes, [best, height]);
         TextureLayout {
             nodes,
             objects,
@@ -191,18 +185,12 @@ impl TextureLayout {
     }
 
     pub fn extent(&self) -> [u32; 3] {
-        let rows = self.nodes.div_ceil(self.columns);
-        [
-            self.columns * self.region[0],
-            rows * self.region[1],
-            self.objects,
-        ]
+        regions_extent(self.nodes, self.columns, self.region, self.objects)
     }
 
     /// Bytes of the texture at `texel_bytes` per texel.
     pub fn bytes(&self, texel_bytes: u64) -> u64 {
-        let [x, y, z] = self.extent();
-        u64::from(x) * u64::from(y) * u64::from(z) * texel_bytes
+        texture_bytes(self.extent(), texel_bytes)
     }
 
     /// Texel of the kernel centre of `level` at field node `node`.
@@ -319,9 +307,7 @@ impl LayerLayout {
             x += width;
             height = height.max(width);
         }
-        let columns = (1..=nodes)
-            .min_by_key(|&c| (c * x).max(nodes.div_ceil(c) * height))
-            .unwrap_or(1);
+        let columns = square_columns(nodes, [x, height]);
         LayerLayout {
             nodes,
             objects,
@@ -333,17 +319,11 @@ impl LayerLayout {
     }
 
     pub fn extent(&self) -> [u32; 3] {
-        let rows = self.nodes.div_ceil(self.columns);
-        [
-            self.columns * self.region[0],
-            rows * self.region[1],
-            self.objects,
-        ]
+        regions_extent(self.nodes, self.columns, self.region, self.objects)
     }
 
     pub fn bytes(&self, texel_bytes: u64) -> u64 {
-        let [x, y, z] = self.extent();
-        u64::from(x) * u64::from(y) * u64::from(z) * texel_bytes
+        texture_bytes(self.extent(), texel_bytes)
     }
 
     /// The LayerAtlas buffer: the region, regions per row and R; per kind its offset-0 texel,
@@ -367,6 +347,27 @@ impl LayerLayout {
         let [x, y, z] = self.extent();
         x.max(y).max(z) <= ctx.limits().max_image_dimension3_d
     }
+}
+
+/// Regions per texture row for `nodes` regions of size `region`: the arrangement closest to
+/// square (long thin textures would run into the device's side limit first).
+fn square_columns(nodes: u32, region: [u32; 2]) -> u32 {
+    (1..=nodes)
+        .min_by_key(|&c| (c * region[0]).max(nodes.div_ceil(c) * region[1]))
+        .unwrap_or(1)
+}
+
+/// A texture of `nodes` regions, `columns` to a row, one layer per object distance.
+fn regions_extent(nodes: u32, columns: u32, region: [u32; 2], objects: u32) -> [u32; 3] {
+    [
+        columns * region[0],
+        nodes.div_ceil(columns) * region[1],
+        objects,
+    ]
+}
+
+fn texture_bytes([x, y, z]: [u32; 3], texel_bytes: u64) -> u64 {
+    u64::from(x) * u64::from(y) * u64::from(z) * texel_bytes
 }
 
 /// Radius levels of a layout's slots (the plain ones come first, one per level).
