@@ -34,17 +34,20 @@ SWEEP = [
     ("merge colour error", "--merge-color-error", ["0.0039", "0.0156", "0.0625"]),
     ("tile size", "--tile-size", ["8", "16", "32"]),
     ("texture format", "--texture-format", ["rgba16f", "rgba32f"]),
+    # a switch: "on" passes the flag alone (the radius levels instead of the layer kernels)
+    ("kernel reads: levels", "--level-kernels", ["on"]),
     ("beta degree", "--beta-degree", ["10", "20", "60", "160"]),
     ("PSF sample (um)", "--sample-um", ["2", "4", "8"]),
 ]
 DEFAULTS = {
     "--object-samples": "41",
     "--rmax-cap": "64",
-    "--merge-levels": "1",
+    "--merge-levels": "5",
     "--merge-min-radius": "5",
-    "--merge-color-error": "0.0039",
+    "--merge-color-error": "0.00098",
     "--tile-size": "8",
     "--texture-format": "rgba16f",
+    "--level-kernels": "off",
     "--beta-degree": "160",
     "--sample-um": "4",
 }
@@ -84,7 +87,8 @@ def main():
         for value in values:
             if value == DEFAULTS[flag]:
                 continue
-            splat, seconds = compare(args, ["--truth-in", truth, flag, value], scratch)
+            extra = [flag] if value == "on" else [flag, value]
+            splat, seconds = compare(args, ["--truth-in", truth] + extra, scratch)
             rows.append({"setting": name, "value": value, "psnr_db": splat["psnr_db"], "mssim": splat["mssim"],
                          "flip": splat["flip_mean"], "gpu_ms": splat["gpu_ms"], "default": False})
             print(f"  {name:<24} {value:>8}: {splat['psnr_db'] or float('inf'):7.2f} dB  MSSIM {splat['mssim']:.5f}  "
