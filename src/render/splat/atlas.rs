@@ -293,11 +293,8 @@ impl LayerLayout {
         for side in sides {
             // A plain kernel's offset 0 is its centre texel, r + 1 from the slot's edge; a
             // block's is the texel that begins at it, r + s/2 + 1 from the edge.
-            let (width, edge) = if side == 0 {
-                (2 * r + 3, r + 1)
-            } else {
-                (2 * r + side + 2, r + side / 2 + 1)
-            };
+            let width = layer_slot_width(r, side);
+            let edge = if side == 0 { r + 1 } else { r + side / 2 + 1 };
             let kind = if side == 0 {
                 0
             } else {
@@ -346,6 +343,16 @@ impl LayerLayout {
     pub fn fits(&self, ctx: &Context) -> bool {
         let [x, y, z] = self.extent();
         x.max(y).max(z) <= ctx.limits().max_image_dimension3_d
+    }
+}
+
+/// Texels across a layer-texture slot of kernels up to radius `r` for blocks of `side` (0:
+/// plain), its zero ring included.
+pub(super) fn layer_slot_width(r: u32, side: u32) -> u32 {
+    if side == 0 {
+        2 * r + 3
+    } else {
+        2 * r + side + 2
     }
 }
 

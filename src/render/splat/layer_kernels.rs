@@ -4,7 +4,7 @@
 
 use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
 
-use super::atlas::LayerLayout;
+use super::atlas::{layer_slot_width, LayerLayout};
 use super::Resources;
 
 shader_block! {
@@ -46,11 +46,7 @@ impl LayerKernelsPass {
         for node in 0..layout.nodes {
             for (kind, slot) in layout.kinds.iter().enumerate() {
                 let Some((_, side)) = slot else { continue };
-                let width = if *side == 0 {
-                    2 * layout.max_radius + 3
-                } else {
-                    2 * layout.max_radius + side + 2
-                };
+                let width = layer_slot_width(layout.max_radius, *side);
                 rec.compute(&self.pipeline)
                     .read("psf_texture", (r.texture, r.sampler))
                     .write("layer_texture", r.layer_texture)

@@ -388,8 +388,9 @@ impl Splatter {
             self.frame.as_ref().expect("ensured above"),
             projection.focal_px() as f32,
         );
-        params.radius_step = self.layer_radius_step(&radii).unwrap_or(0.0);
-        params.layered = u32::from(self.layer_radius_step(&radii).is_some());
+        let step = self.layer_radius_step(&radii);
+        params.radius_step = step.unwrap_or(0.0);
+        params.layered = u32::from(step.is_some());
         // Through the persistent mapping: submissions complete before `submit` returns, so no
         // earlier frame still reads it.
         let frame_mut = self.frame.as_mut().expect("ensured above");
