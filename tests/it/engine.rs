@@ -405,15 +405,27 @@ fn layer_kernels_match_the_radius_levels() {
     };
     let (layers, levels) = (run(true), run(false));
     let peak = 4.0f64;
-    let mse = layers
-        .iter()
-        .zip(&levels)
-        .flat_map(|(a, b)| (0..3).map(move |c| (f64::from(a[c]) - f64::from(b[c])).powi(2)))
-        .sum::<f64>()
-        / (3 * layers.len()) as f64;
-    let db = 10.0 * (peak * peak / mse).log10();
-    eprintln!("layer kernels against the radius levels: {db:.2} dB (peak {peak})");
+    let db_of = |image: &[[f32; 4]]| {
+        let mse = image
+            .iter()
+            .zip(&levels)
+            .flat_map(|(a, b)| (0..3).map(move |c| (f64::from(a[c]) - f64::from(b[c])).powi(2)))
+            .sum::<f64>()
+            / (3 * image.len()) as f64;
+        10.0 * (peak * peak / mse).log10()
+    };
+    let db = db_of(&layers);
+    // Negative control: the unblurred input, in the layer kernels' place.
+    let sharp = db_of(&frame.color);
+    eprintln!(
+        "layer kernels against the radius levels: {db:.2} dB (peak {peak}); the unblurred input \
+         {sharp:.2} dB"
+    );
     assert!(db > LAYERS_AGAINST_LEVELS_DB, "{db} dB");
+    assert!(
+        sharp < LAYERS_AGAINST_LEVELS_DB,
+        "the control passed: {sharp} dB"
+    );
     common::finish(ctx);
 }
 
