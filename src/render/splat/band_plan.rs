@@ -2,7 +2,7 @@
 //! the prefix sum, and writes the band table the list passes read (their ranges and the
 //! indirect dispatches of tile sort and convolve). See glsl/render/splat/band_plan.comp.
 
-use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, GpuResult, Recorder};
 
 use super::Resources;
 
@@ -20,19 +20,7 @@ shader_block! {
     }
 }
 
-pub(super) struct BandPlanPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for BandPlanPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline =
-            ComputePipeline::builder("band plan", crate::shaders::RENDER_SPLAT_BAND_PLAN_COMP)
-                .push_constants::<BandPlanPush>()
-                .build(ctx)?;
-        Ok(BandPlanPass { pipeline })
-    }
-}
+super::passes::compute_pass!(BandPlanPass, "band plan", RENDER_SPLAT_BAND_PLAN_COMP, push: BandPlanPush);
 
 impl BandPlanPass {
     /// Plans `slots` slots of the band table for a list buffer of `capacity` entries, from

@@ -2,7 +2,7 @@
 //! See glsl/render/splat/fragments.comp.
 
 use crate::gpu::{
-    shader_block, Bindable, Binding, Buffer, ComputePipeline, Context, GpuResult, Recorder,
+    shader_block, Bindable, Binding, Buffer, Context, GpuResult, Recorder,
     Residency,
 };
 
@@ -100,19 +100,7 @@ shader_block! {
     }
 }
 
-pub(super) struct FragmentsPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for FragmentsPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline =
-            ComputePipeline::builder("fragments", crate::shaders::RENDER_SPLAT_FRAGMENTS_COMP)
-                .push_constants::<FragmentsPush>()
-                .build(ctx)?;
-        Ok(FragmentsPass { pipeline })
-    }
-}
+super::passes::compute_pass!(FragmentsPass, "fragments", RENDER_SPLAT_FRAGMENTS_COMP, push: FragmentsPush);
 
 impl FragmentsPass {
     pub fn record(

@@ -7,7 +7,7 @@
 //! hands its depth to the next peel on the GPU. Both feed the same passes after this.
 
 use crate::gpu::{
-    shader_block, Buffer, ComputePipeline, Context, GpuResult, Image, Recorder, Residency,
+    shader_block, Buffer, Context, GpuResult, Image, Recorder, Residency,
 };
 use crate::{Error, Result};
 
@@ -83,18 +83,7 @@ shader_block! {
     }
 }
 
-pub(super) struct InputPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for InputPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline = ComputePipeline::builder("input", crate::shaders::RENDER_SPLAT_INPUT_COMP)
-            .push_constants::<InputPush>()
-            .build(ctx)?;
-        Ok(InputPass { pipeline })
-    }
-}
+super::passes::compute_pass!(InputPass, "input", RENDER_SPLAT_INPUT_COMP, push: InputPush);
 
 impl Source<'_, '_> {
     /// The frame's size, layers and field, after checking that its parts agree.

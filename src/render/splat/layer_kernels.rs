@@ -2,7 +2,7 @@
 //! radius levels, so that the convolution reads one texel for all channels. See
 //! glsl/render/splat/layer_kernels.comp.
 
-use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, GpuResult, Recorder};
 
 use super::atlas::{layer_slot_width, LayerLayout};
 use super::Resources;
@@ -18,21 +18,7 @@ shader_block! {
     }
 }
 
-pub(super) struct LayerKernelsPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for LayerKernelsPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline = ComputePipeline::builder(
-            "layer kernels",
-            crate::shaders::RENDER_SPLAT_LAYER_KERNELS_COMP,
-        )
-        .push_constants::<LayerKernelsPush>()
-        .build(ctx)?;
-        Ok(LayerKernelsPass { pipeline })
-    }
-}
+super::passes::compute_pass!(LayerKernelsPass, "layer kernels", RENDER_SPLAT_LAYER_KERNELS_COMP, push: LayerKernelsPush);
 
 impl LayerKernelsPass {
     /// Writes every node's slots of `layout` from the PSF texture, which must hold this

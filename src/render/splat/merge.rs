@@ -2,7 +2,7 @@
 //! optionally 4×4 up to 32×32): the seed paper's similar-colour rule, or level of detail by
 //! blur. See glsl/render/splat/merge.comp.
 
-use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, GpuResult, Recorder};
 
 use super::Resources;
 
@@ -18,18 +18,7 @@ shader_block! {
     }
 }
 
-pub(super) struct MergePass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for MergePass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline = ComputePipeline::builder("merge", crate::shaders::RENDER_SPLAT_MERGE_COMP)
-            .push_constants::<MergePush>()
-            .build(ctx)?;
-        Ok(MergePass { pipeline })
-    }
-}
+super::passes::compute_pass!(MergePass, "merge", RENDER_SPLAT_MERGE_COMP, push: MergePush);
 
 impl MergePass {
     /// `levels`: 1 merges 2×2 blocks, 2 also merges 2×2 blocks of merged blocks, and so on.

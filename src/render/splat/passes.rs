@@ -25,6 +25,33 @@ pub(super) trait Pass: Sized {
     fn new(ctx: &Context, config: &PassConfig) -> GpuResult<Self>;
 }
 
+/// Declares a pass that owns one compute pipeline, built from its shader with no pipeline
+/// constants: `compute_pass!(Doc TileCountPass, "tile count", RENDER_SPLAT_TILE_COUNT_COMP)`,
+/// with `push: Type` where its dispatches take push constants. A pass whose pipelines depend
+/// on the [`PassConfig`] or the device implements [`Pass`] itself.
+macro_rules! compute_pass {
+    ($(#[$doc:meta])* $name:ident, $label:literal, $spirv:ident $(, push: $push:ty)?) => {
+        $(#[$doc])*
+        pub(super) struct $name {
+            pipeline: crate::gpu::ComputePipeline,
+        }
+
+        impl super::passes::Pass for $name {
+            fn new(
+                ctx: &crate::gpu::Context,
+                _: &super::passes::PassConfig,
+            ) -> crate::gpu::GpuResult<Self> {
+                let builder = crate::gpu::ComputePipeline::builder($label, crate::shaders::$spirv);
+                $(let builder = builder.push_constants::<$push>();)?
+                Ok($name {
+                    pipeline: builder.build(ctx)?,
+                })
+            }
+        }
+    };
+}
+pub(super) use compute_pass;
+
 /// Declares each pass's module and the struct that holds one of each, in frame order:
 /// `passes! { field: module::Type, … }`.
 macro_rules! passes {

@@ -1,7 +1,7 @@
 //! Prefix-sum pass: exclusive scan of the tile counts into list offsets, plus the total.
 //! See glsl/render/splat/prefix_sum.comp.
 
-use crate::gpu::{shader_block, ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{shader_block, GpuResult, Recorder};
 
 use super::Resources;
 
@@ -17,19 +17,7 @@ shader_block! {
     }
 }
 
-pub(super) struct PrefixSumPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for PrefixSumPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline =
-            ComputePipeline::builder("prefix sum", crate::shaders::RENDER_SPLAT_PREFIX_SUM_COMP)
-                .push_constants::<PrefixSumPush>()
-                .build(ctx)?;
-        Ok(PrefixSumPass { pipeline })
-    }
-}
+super::passes::compute_pass!(PrefixSumPass, "prefix sum", RENDER_SPLAT_PREFIX_SUM_COMP, push: PrefixSumPush);
 
 impl PrefixSumPass {
     /// Scans the tile counts into the offsets (tiles + 1 elements: the total last).

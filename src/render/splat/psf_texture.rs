@@ -2,7 +2,7 @@
 //! into the 3D texture the convolution samples. See glsl/render/splat/psf_texture.comp.
 
 use crate::gpu::{
-    shader_block, Binding, Buffer, ComputePipeline, Context, GpuResult, Image, ImageUsage,
+    shader_block, Binding, Buffer, Context, GpuResult, Image, ImageUsage,
     Recorder, TexelFormat,
 };
 use crate::psf::kernels::{
@@ -172,19 +172,7 @@ fn upload_set(
         .collect()
 }
 
-pub(super) struct PsfTexturePass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for PsfTexturePass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline =
-            ComputePipeline::builder("psf texture", crate::shaders::RENDER_SPLAT_PSF_TEXTURE_COMP)
-                .push_constants::<PsfTexturePush>()
-                .build(ctx)?;
-        Ok(PsfTexturePass { pipeline })
-    }
-}
+super::passes::compute_pass!(PsfTexturePass, "psf texture", RENDER_SPLAT_PSF_TEXTURE_COMP, push: PsfTexturePush);
 
 impl PsfTexturePass {
     /// Writes each field node's kernels for `blend` into its region of the PSF texture, whose

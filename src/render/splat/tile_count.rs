@@ -1,22 +1,11 @@
 //! Tile-count pass: how many fragments each screen tile's list will hold (exact overlap of the
 //! kernel's square support with the tile). See glsl/render/splat/tile_count.comp.
 
-use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{GpuResult, Recorder};
 
 use super::Resources;
 
-pub(super) struct TileCountPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for TileCountPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline =
-            ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
-                .build(ctx)?;
-        Ok(TileCountPass { pipeline })
-    }
-}
+super::passes::compute_pass!(TileCountPass, "tile count", RENDER_SPLAT_TILE_COUNT_COMP);
 
 impl TileCountPass {
     /// `r.frame.counts` must be zeroed (tiles + 3 elements: the live fragments and the kernel

@@ -1,24 +1,12 @@
 //! Tile-fill pass: writes each fragment's (depth, index) key into the list of every tile of
 //! the current band it reaches. See glsl/render/splat/tile_fill.comp.
 
-use crate::gpu::{ComputePipeline, Context, GpuResult, Recorder};
+use crate::gpu::{GpuResult, Recorder};
 
 use super::bands::{BandPush, BandSlot};
 use super::Resources;
 
-pub(super) struct TileFillPass {
-    pipeline: ComputePipeline,
-}
-
-impl super::passes::Pass for TileFillPass {
-    fn new(ctx: &Context, _: &super::passes::PassConfig) -> GpuResult<Self> {
-        let pipeline =
-            ComputePipeline::builder("tile fill", crate::shaders::RENDER_SPLAT_TILE_FILL_COMP)
-                .push_constants::<BandPush>()
-                .build(ctx)?;
-        Ok(TileFillPass { pipeline })
-    }
-}
+super::passes::compute_pass!(TileFillPass, "tile fill", RENDER_SPLAT_TILE_FILL_COMP, push: BandPush);
 
 impl TileFillPass {
     /// `r.frame.cursors` must be zeroed; `band.entries` receives the lists of the band in
