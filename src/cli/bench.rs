@@ -59,12 +59,8 @@ pub struct BenchArgs {
     /// early exit) and print the ratio.
     #[arg(long)]
     pub baseline: bool,
-    /// Kernel cache folder (default: the user cache); --no-cache times the precomputation.
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    pub cache: Option<PathBuf>,
-    /// Neither read nor write the kernel cache.
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Write the results as JSON.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
@@ -362,7 +358,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let (width, height) = args.size;
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
-    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = args.cache.kernel_options();
     options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let precompute = Precompute::of(&kernels);
@@ -378,7 +374,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = frame.input(screen.fov_y_deg);
     let runs = if args.baseline { 2 } else { 1 };
-    let bar = frame_bar((runs * (args.warmup + args.frames)) as u64);
+    let bar = super::frame_progress_bar((runs * (args.warmup + args.frames)) as u64);
     let scene_state = scene.at_time(0.0);
     let mut raster = Rasterizer::new(&ctx)?;
     let mut scene_input = SceneInput {
@@ -524,22 +520,6 @@ fn method_times(
         });
     }
     Ok(methods)
-}
-
-fn frame_bar(total: u64) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(total);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "frames [{bar:30}] {pos}/{len} {per_sec} ETA {eta}",
-        )
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar
 }
 
 fn print_table(r: &Report) {

@@ -105,12 +105,8 @@ pub struct CompareArgs {
     /// Write truth.png, splat.png, slices.png and the SSIM maps (ssim_splat.png, ssim_slices.png).
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
-    /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    pub cache: Option<PathBuf>,
-    /// Neither read nor write the kernel cache.
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Viewing condition of the FLIP column in pixels per degree (default: FLIP's 67.02,
     /// 0.7 m from a 0.7 m wide monitor 3840 pixels across).
     #[arg(long, value_name = "N", default_value_t = crate::metrics::flip::DEFAULT_PPD)]
@@ -385,7 +381,7 @@ fn read_images(args: &CompareArgs) -> Result<(Option<ImageRgba>, Judged)> {
 
 /// The kernel options the comparison's flags set, validated with the flags named.
 fn kernel_options(args: &CompareArgs) -> Result<KernelOptions> {
-    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = args.cache.kernel_options();
     options.reference_axes.objects =
         crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
     options.settings.max_radius_cap = args.rmax_cap;

@@ -36,7 +36,8 @@ pub struct CorrectionArgs {
     pub accommodation_max_d: Option<f64>,
 }
 
-fn number(text: &str) -> std::result::Result<f64, String> {
+/// A finite number from an option's text (clap value parsers of correction and refract).
+pub(super) fn number(text: &str) -> std::result::Result<f64, String> {
     text.trim()
         .parse::<f64>()
         .ok()

@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use crate::eye::Eye;
 use crate::psf::axes::{GridAxes, KernelSettings, Screen};
-use crate::psf::cache::{cached, default_cache_dir, grid_key, write_grid, CacheOutcome};
+use crate::psf::cache::{cached, grid_key, write_grid, CacheOutcome};
 use crate::psf::field::FieldAxes;
 use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::DioptreAxis;
@@ -57,12 +57,8 @@ pub struct KernelsArgs {
     /// one --pupils-mm value this is a single column of the grid.
     #[arg(long, value_name = "MIN..MAX")]
     pub scene_d: Option<String>,
-    /// Cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    pub cache: Option<PathBuf>,
-    /// Neither read nor write the cache.
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Output grid file.
     #[arg(short = 'o', long, value_name = "FILE")]
     pub output: PathBuf,
@@ -211,11 +207,7 @@ pub fn run(args: &KernelsArgs) -> Result<()> {
         skipped,
         notes,
     } = planned_grid(args)?;
-    let dir = if args.no_cache {
-        None
-    } else {
-        args.cache.clone().or_else(default_cache_dir)
-    };
+    let dir = args.cache.dir();
     let mut field = field;
     if auto {
         let (fresh, axes) = auto_field(args, &eye, &axes, &screen)?;

@@ -237,37 +237,45 @@ impl SplatArgs {
     }
 }
 
-/// Kernel options honouring `--cache DIR` and `--no-cache`.
-pub(crate) fn kernel_options(
-    cache: Option<&std::path::PathBuf>,
-    no_cache: bool,
-) -> crate::render::frame::KernelOptions {
-    let mut options = crate::render::frame::KernelOptions {
-        progress: Some(kernel_progress_bar()),
-        ..crate::render::frame::KernelOptions::default()
-    };
-    if no_cache {
-        options.cache_dir = None;
-    } else if let Some(dir) = cache {
-        options.cache_dir = Some(dir.clone());
+/// The kernel cache options of the commands that compute kernels: one struct, flattened into
+/// each.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CacheArgs {
+    /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
+    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
+    pub cache: Option<std::path::PathBuf>,
+    /// Neither read nor write the kernel cache.
+    #[arg(long)]
+    pub no_cache: bool,
+}
+
+impl CacheArgs {
+    /// The cache folder: none with `--no-cache`, else `--cache DIR`, else the user's cache.
+    pub(crate) fn dir(&self) -> Option<std::path::PathBuf> {
+        if self.no_cache {
+            None
+        } else {
+            self.cache
+                .clone()
+                .or_else(crate::psf::cache::default_cache_dir)
+        }
     }
-    options
+
+    /// Kernel options with this cache and a progress bar on a terminal.
+    pub(crate) fn kernel_options(&self) -> crate::render::frame::KernelOptions {
+        crate::render::frame::KernelOptions {
+            progress: Some(kernel_progress_bar()),
+            cache_dir: self.dir(),
+            ..crate::render::frame::KernelOptions::default()
+        }
+    }
 }
 
 /// A progress bar for kernel computation on a terminal (hidden otherwise); it clears itself
 /// when the last stage completes.
 fn kernel_progress_bar() -> crate::render::frame::ProgressHook {
     use crate::psf::grid::Stage;
-    use std::io::IsTerminal;
-    let bar = if std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::new(0).with_style(
-            indicatif::ProgressStyle::with_template("{msg:>10} [{bar:30}] {pos}/{len} ETA {eta}")
-                .expect("static template")
-                .progress_chars("=> "),
-        )
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = terminal_bar(0, "{msg:>10} [{bar:30}] {pos}/{len} ETA {eta}");
     std::sync::Arc::new(move |stage: Stage, done: usize, total: usize| {
         let label = match stage {
             Stage::Optics => "eye optics",
@@ -281,6 +289,24 @@ fn kernel_progress_bar() -> crate::render::frame::ProgressHook {
             bar.finish_and_clear();
         }
     })
+}
+
+/// A progress bar of `total` steps drawn with `template` on a terminal; hidden otherwise.
+fn terminal_bar(total: u64, template: &'static str) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    indicatif::ProgressBar::new(total).with_style(
+        indicatif::ProgressStyle::with_template(template)
+            .expect("static template")
+            .progress_chars("=> "),
+    )
+}
+
+/// The frame counter of the commands that render many frames (video, bench).
+pub(crate) fn frame_progress_bar(total: u64) -> indicatif::ProgressBar {
+    terminal_bar(total, "frames [{bar:30}] {pos}/{len} {per_sec} ETA {eta}")
 }
 
 /// Loads or computes kernels (`render::frame::prepare_kernels`) and prints their warnings.

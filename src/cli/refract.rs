@@ -3,6 +3,7 @@
 
 use clap::Args;
 
+use super::correction::number;
 use crate::eye::correction::{format_rx, DEFAULT_VERTEX_MM};
 use crate::eye::file as eye_file;
 use crate::eye::refract::refract;
@@ -25,14 +26,6 @@ pub struct RefractArgs {
     /// Print JSON (sphere_d, cylinder_d, axis_deg, rx, and the measurement behind them).
     #[arg(long)]
     pub json: bool,
-}
-
-fn number(text: &str) -> std::result::Result<f64, String> {
-    text.trim()
-        .parse::<f64>()
-        .ok()
-        .filter(|v| v.is_finite())
-        .ok_or_else(|| format!("{text:?} is not a number"))
 }
 
 fn parse_pupil_mm(text: &str) -> std::result::Result<f64, String> {

@@ -142,12 +142,8 @@ pub struct RenderArgs {
     pub layers: Option<u32>,
     #[command(flatten)]
     pub splat: super::SplatArgs,
-    /// Kernel cache folder (default: $XDG_CACHE_HOME/ocular or ~/.cache/ocular).
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    pub cache: Option<PathBuf>,
-    /// Compute kernels without reading or writing the cache.
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Print the GPU time of each splatting pass.
     #[arg(long)]
     pub timings: bool,
@@ -526,7 +522,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         frame_plan::focus_d(focus_asked(args)?, &input.scene_eye(), &input.view())?;
     let (pupil_mm, pupil_source) =
         frame_plan::pupil_mm(&pupil_asked(args), &input.scene_eye(), &input.view())?;
-    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = args.cache.kernel_options();
     if args.splat.off_axis {
         if matches!(args.method, Method::Slices | Method::Views) {
             return Err(Error::input(

@@ -106,12 +106,8 @@ pub struct VideoArgs {
     /// --layers`).
     #[arg(long, value_name = "K", value_parser = super::occlusion::parse_layers)]
     pub layers: Option<u32>,
-    /// Kernel cache folder; --no-cache disables it.
-    #[arg(long, value_name = "DIR", conflicts_with = "no_cache")]
-    pub cache: Option<PathBuf>,
-    /// Neither read nor write the kernel cache.
-    #[arg(long)]
-    pub no_cache: bool,
+    #[command(flatten)]
+    pub cache: super::CacheArgs,
     /// Replace an export of another configuration in the folder: its manifest, digests and
     /// frames are removed first (not for split jobs running at the same time).
     #[arg(long)]
@@ -268,7 +264,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     let (width, height) = args
         .size
         .unwrap_or((timeline.scene.resolution[0], timeline.scene.resolution[1]));
-    let mut options = super::kernel_options(args.cache.as_ref(), args.no_cache);
+    let mut options = args.cache.kernel_options();
     options.field_width_px = args.off_axis.then_some(width);
     let config = export_config(args, &timeline, &eyes, (width, height), &options)?;
     // Checked before the manifest is published: a refused run leaves the folder as it was.
@@ -478,7 +474,7 @@ impl Export<'_> {
             .map(|(_, e)| crate::render::frame_plan::spectacle_magnification(e))
             .collect::<Result<Vec<_>>>()?;
         let labels: Vec<&str> = self.eyes.iter().map(|(name, _)| name.as_str()).collect();
-        let bar = progress_bar(todo.len() as u64);
+        let bar = super::frame_progress_bar(todo.len() as u64);
         for &i in todo {
             let state = self.timeline.state(i);
             let panels = video_frame::render_panels(
@@ -514,22 +510,6 @@ impl Export<'_> {
         bar.finish_and_clear();
         Ok(())
     }
-}
-
-fn progress_bar(total: u64) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(total);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "frames [{bar:30}] {pos}/{len} {per_sec} ETA {eta}",
-        )
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar
 }
 
 #[cfg(test)]
