@@ -1,6 +1,6 @@
 //! The binary end to end: version, device listing, and a clear exit-2 error for a bad device.
 
-use crate::common::ocular;
+use crate::common::{json_ok, ocular};
 
 #[test]
 fn version_prints_the_crate_version() {
@@ -19,12 +19,7 @@ fn devices_lists_and_marks_the_selected_device() {
         .env_remove("OCULAR_DEVICE")
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = json_ok(&out);
     let devices = report["devices"].as_array().unwrap();
     assert!(!devices.is_empty());
     let selected = report["selected"].as_u64().unwrap() as usize;

@@ -1,7 +1,7 @@
 //! `ocular kernels` end to end on a tiny grid: files written, the cache hit on a second run,
 //! clear exit-2 errors for bad options.
 
-use crate::common::{ocular, temp_dir};
+use crate::common::{json_ok, ocular, ok, temp_dir};
 use ocular::psf::cache::read_grid;
 
 #[test]
@@ -41,12 +41,7 @@ fn kernels_writes_grid_pictures_and_uses_the_cache() {
         a
     };
     let out = ocular().args(args(true)).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let report = json_ok(&out);
     assert_eq!(report["psfs"], 7 * 2 * 2 * 3);
     assert_eq!(report["sets"], 4);
     let grid = read_grid(&dir.join("grid.bin"), None).unwrap();
@@ -113,11 +108,7 @@ fn kernels_report_the_missed_pupil_energy_per_column() {
         .arg(dir.join("k.bin"))
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let report = &json["report"];

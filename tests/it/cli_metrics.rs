@@ -3,7 +3,7 @@
 //! from its definition, the map file, and one-line exit-2 errors for bad input that leave no
 //! file behind.
 
-use crate::common::{ocular, temp_dir};
+use crate::common::{json_ok, ocular, ok, temp_dir};
 use std::path::Path;
 use std::process::Output;
 
@@ -37,15 +37,6 @@ fn run(args: &[&str]) -> Output {
     ocular().arg("metrics").args(args).output().unwrap()
 }
 
-fn json(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
 fn oracle_mean(case: &str) -> f64 {
     let text = std::fs::read_to_string(format!("{DATA}/cases.json")).unwrap();
     let v: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -73,7 +64,7 @@ fn hdr_pair_gets_hdr_flip_as_the_reference_computes_it() {
     );
     exr(&r, &read_f32("hdr_ref.f32"), (W, H));
     exr(&t, &read_f32("hdr_test.f32"), (W, H));
-    let report = json(&run(&[s(&r), s(&t), "--json", "--map", s(&map)]));
+    let report = json_ok(&run(&[s(&r), s(&t), "--json", "--map", s(&map)]));
     assert_eq!(report["dynamic_range"], "hdr");
     assert_eq!(report["flip"]["metric"], "HDR-FLIP");
     let mean = report["flip"]["mean"].as_f64().unwrap();
@@ -87,7 +78,7 @@ fn hdr_pair_gets_hdr_flip_as_the_reference_computes_it() {
             && q("q3") <= q("max")
     );
     // another tone mapper and a given range change the result as the reference's do
-    let reinhard = json(&run(&[
+    let reinhard = json_ok(&run(&[
         s(&r),
         s(&t),
         "--json",
@@ -149,18 +140,18 @@ fn png_pair_gets_ldr_flip_psnr_and_ssim() {
         );
         nv_flip::FlipPool::from_image(&m).mean() as f64
     };
-    let default = json(&run(&[s(&r), s(&t), "--json"]));
+    let default = json_ok(&run(&[s(&r), s(&t), "--json"]));
     assert_eq!(default["flip"]["metric"], "LDR-FLIP");
     let mean = default["flip"]["mean"].as_f64().unwrap();
     assert!((mean - oracle(67.020_645)).abs() < 1e-5, "{mean}");
-    let at_30 = json(&run(&[s(&r), s(&t), "--json", "--ppd", "30"]))["flip"]["mean"]
+    let at_30 = json_ok(&run(&[s(&r), s(&t), "--json", "--ppd", "30"]))["flip"]["mean"]
         .as_f64()
         .unwrap();
     assert!((at_30 - oracle(30.0)).abs() < 1e-5, "{at_30}");
     // the control: the two viewing distances must be told apart by the bar
     assert!((at_30 - mean).abs() > 1e-3);
     // FLIP's default monitor gives the default ppd
-    let monitor = json(&run(&[s(&r), s(&t), "--json", "--monitor", "0.7,3840,0.7"]));
+    let monitor = json_ok(&run(&[s(&r), s(&t), "--json", "--monitor", "0.7,3840,0.7"]));
     assert_eq!(monitor["flip"]["mean"], default["flip"]["mean"]);
     // PSNR from its definition on the stored 8-bit values
     let mse = ref8
@@ -174,7 +165,7 @@ fn png_pair_gets_ldr_flip_psnr_and_ssim() {
     let mssim = default["mssim"].as_f64().unwrap();
     assert!(mssim > 0.0 && mssim < 1.0);
     // identical images: no error, PSNR null, and the table says ∞
-    let same = json(&run(&[s(&r), s(&r), "--json"]));
+    let same = json_ok(&run(&[s(&r), s(&r), "--json"]));
     assert_eq!(same["flip"]["mean"], 0.0);
     assert!(same["psnr_db"].is_null());
     let table = run(&[s(&r), s(&r)]);
@@ -333,11 +324,7 @@ fn compare_reports_flip_of_the_displayed_images() {
         ])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("FLIP"), "{table}");
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();

@@ -2,12 +2,12 @@
 //! used), its range checks, and the retina in eye files (old files load with the wide-angle
 //! retina, a plane is accepted, bad radii and unknown shapes are refused).
 
-use crate::common::{ocular_run, refused, temp_dir};
+use crate::common::{json_ok, ocular_run, ok, refused, temp_dir};
 use ocular::eye::{Eye, Retina};
 use std::process::Output;
 
 fn measure_json(field: &str) -> serde_json::Value {
-    let out = ocular_run(&[
+    json_ok(&ocular_run(&[
         "eye",
         "measure",
         "navarro-wide",
@@ -18,13 +18,7 @@ fn measure_json(field: &str) -> serde_json::Value {
         "--field-deg",
         field,
         "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    ]))
 }
 
 #[test]
@@ -139,11 +133,7 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
             index.to_str().unwrap(),
         ],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let text = std::fs::read_to_string(&index).unwrap();
     assert_eq!(text.matches("[[node]]").count(), 3);
     assert_eq!(text.matches("cached = false").count(), 3);
@@ -202,11 +192,7 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
             auto.to_str().unwrap(),
         ],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let idx: toml::Table = std::fs::read_to_string(&auto).unwrap().parse().unwrap();
     let first = |k: &str| idx[k].as_array().unwrap()[0].as_float().unwrap();
     let h = (20f64.to_radians().tan() * 160.0 / 180.0)

@@ -2,7 +2,7 @@
 //! the option the user gave (defects 9, 10, 11) and small input conveniences work (defect 13).
 //! None of these runs renders: every refusal happens before the GPU or the optics start.
 
-use crate::common::{ocular, ocular_run, p, refused, temp_dir};
+use crate::common::{ocular, ocular_run, ok, p, refused, temp_dir};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
@@ -168,11 +168,7 @@ fn a_failing_second_output_leaves_nothing_behind() {
         "--png",
         p(&d.join("p.png")),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     assert_eq!(files_in(&d), ["p.exr", "p.json", "p.png"]);
 }
 
@@ -370,11 +366,7 @@ fn eye_estimate_term_needs_rx_and_csv_may_carry_a_bom() {
         "-o",
         p(&d.join("w.exr")),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let sidecar: serde_json::Value =
         serde_json::from_slice(&std::fs::read(d.join("w.json")).unwrap()).unwrap();
     assert_eq!(sidecar["pupil_mm"], 5.0);

@@ -1,7 +1,7 @@
 //! `ocular psf` end to end: the EXR is normalised with the optical axis at (N/2, N/2), the
 //! sidecar carries the inputs and accuracy figures, and bad input is exit 2 with no file.
 
-use crate::common::{ocular, temp_dir};
+use crate::common::{ocular, ok, temp_dir};
 
 #[test]
 fn healthy_psf_is_normalised_and_centred() {
@@ -28,11 +28,7 @@ fn healthy_psf_is_normalised_and_centred() {
         .arg(&png)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let image = ocular::image_io::read_exr_depth(&exr).unwrap();
     assert_eq!((image.width, image.height), (65, 65));
     let total: f64 = image.pixels.iter().map(|&v| f64::from(v)).sum();

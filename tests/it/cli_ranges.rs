@@ -3,7 +3,7 @@
 //! just outside the bound with exit 2 and a message that names the option or field and states
 //! the one shared range; a value on the bound passes the same check.
 
-use crate::common::{ocular_run, temp_dir};
+use crate::common::{ocular_run, ok, temp_dir};
 use std::path::PathBuf;
 
 /// The primitives scene with one line replaced, written into `dir`.
@@ -29,6 +29,35 @@ fn refused(args: &[&str], names: &str, allowed: &str) {
     assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
 }
 
+/// `eye measure` of the Navarro eye: the cheapest command that traces.
+fn measure<'a>(pupil_mm: &'a str, wavelength_nm: &'a str) -> [&'a str; 7] {
+    [
+        "eye",
+        "measure",
+        "navarro",
+        "--pupil-mm",
+        pupil_mm,
+        "--wavelength-nm",
+        wavelength_nm,
+    ]
+}
+
+/// `kernels` of the Navarro eye with one option set, written to `grid`.
+fn kernels<'a>(option: &'a str, value: &'a str, grid: &'a str) -> [&'a str; 7] {
+    ["kernels", "--eye", "navarro", option, value, "-o", grid]
+}
+
+/// A Zernike file in `dir` with no terms, only its pupil and wavelength.
+fn zernike_file(dir: &std::path::Path, pupil_mm: &str, wavelength_nm: &str) -> PathBuf {
+    let path = dir.join("z.toml");
+    std::fs::write(
+        &path,
+        format!("pupil_diameter_mm = {pupil_mm}\nwavelength_nm = {wavelength_nm}\n"),
+    )
+    .unwrap();
+    path
+}
+
 const PUPIL: &str = "1 to 9 mm";
 const WAVELENGTH: &str = "380 to 1000 nm";
 const FOV: &str = "0.1 to 170 degrees";
@@ -42,39 +71,14 @@ fn pupil_range_is_the_same_everywhere() {
     let out = exr.to_str().unwrap();
     for p in ["0.99", "9.01"] {
         refused(&["render", "--pupil-mm", p, "-o", png], "--pupil-mm", PUPIL);
-        refused(
-            &[
-                "eye",
-                "measure",
-                "navarro",
-                "--pupil-mm",
-                p,
-                "--wavelength-nm",
-                "555",
-            ],
-            "pupil",
-            PUPIL,
-        );
+        refused(&measure(p, "555"), "pupil", PUPIL);
         let grid = dir.join("g.bin");
         refused(
-            &[
-                "kernels",
-                "--eye",
-                "navarro",
-                "--pupils-mm",
-                p,
-                "-o",
-                grid.to_str().unwrap(),
-            ],
+            &kernels("--pupils-mm", p, grid.to_str().unwrap()),
             "pupils-mm",
             PUPIL,
         );
-        let zernike = dir.join("z.toml");
-        std::fs::write(
-            &zernike,
-            format!("pupil_diameter_mm = {p}\nwavelength_nm = 555\n"),
-        )
-        .unwrap();
+        let zernike = zernike_file(&dir, p, "555");
         refused(
             &["psf", "--zernike", zernike.to_str().unwrap(), "-o", out],
             "pupil diameter",
@@ -91,21 +95,8 @@ fn pupil_range_is_the_same_everywhere() {
             PUPIL,
         );
     }
-    // On the bound: the same checks pass (eye measure is the cheapest command that traces).
-    let ok = ocular_run(&[
-        "eye",
-        "measure",
-        "navarro",
-        "--pupil-mm",
-        "9",
-        "--wavelength-nm",
-        "555",
-    ]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    // On the bound: the same checks pass.
+    ok(&ocular_run(&measure("9", "555")));
 }
 
 #[test]
@@ -114,19 +105,7 @@ fn wavelength_range_is_the_same_everywhere() {
     let out = dir.join("x.exr");
     let out = out.to_str().unwrap();
     for w in ["379", "1001"] {
-        refused(
-            &[
-                "eye",
-                "measure",
-                "navarro",
-                "--pupil-mm",
-                "4",
-                "--wavelength-nm",
-                w,
-            ],
-            "wavelength",
-            WAVELENGTH,
-        );
+        refused(&measure("4", w), "wavelength", WAVELENGTH);
         refused(
             &[
                 "psf",
@@ -141,45 +120,20 @@ fn wavelength_range_is_the_same_everywhere() {
             WAVELENGTH,
         );
         let grid = dir.join("g.bin");
+        let wavelengths = format!("{w},549,464");
         refused(
-            &[
-                "kernels",
-                "--eye",
-                "navarro",
-                "--wavelengths-nm",
-                &format!("{w},549,464"),
-                "-o",
-                grid.to_str().unwrap(),
-            ],
+            &kernels("--wavelengths-nm", &wavelengths, grid.to_str().unwrap()),
             "wavelengths-nm",
             WAVELENGTH,
         );
-        let zernike = dir.join("z.toml");
-        std::fs::write(
-            &zernike,
-            format!("pupil_diameter_mm = 5\nwavelength_nm = {w}\n"),
-        )
-        .unwrap();
+        let zernike = zernike_file(&dir, "5", w);
         refused(
             &["psf", "--zernike", zernike.to_str().unwrap(), "-o", out],
             "wavelength",
             WAVELENGTH,
         );
     }
-    let ok = ocular_run(&[
-        "eye",
-        "measure",
-        "navarro",
-        "--pupil-mm",
-        "4",
-        "--wavelength-nm",
-        "1000",
-    ]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
+    ok(&ocular_run(&measure("4", "1000")));
 }
 
 #[test]
@@ -189,19 +143,7 @@ fn field_of_view_range_is_the_same_everywhere() {
     let out = out.to_str().unwrap();
     for f in ["0.09", "170.5"] {
         let grid = dir.join("g.bin");
-        refused(
-            &[
-                "kernels",
-                "--eye",
-                "navarro",
-                "--fov-y",
-                f,
-                "-o",
-                grid.to_str().unwrap(),
-            ],
-            "fov-y",
-            FOV,
-        );
+        refused(&kernels("--fov-y", f, grid.to_str().unwrap()), "fov-y", FOV);
         let scene = primitives_with(&dir, "fov_y_deg = 60.0", &format!("fov_y_deg = {f}"));
         refused(
             &["raster", "--scene", scene.to_str().unwrap(), "-o", out],

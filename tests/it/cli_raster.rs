@@ -1,6 +1,6 @@
 //! `ocular raster` end to end: outputs on success, one clear line and exit code 2 on bad input.
 
-use crate::common::{data, ocular, temp_dir};
+use crate::common::{data, ocular, ok, temp_dir};
 
 #[test]
 fn raster_writes_colour_depth_and_preview() {
@@ -148,11 +148,7 @@ camera = { position = [0.0, 0.0, -3.0] }
             .arg(&depth)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        ok(&out);
         let d = ocular::image_io::read_exr_depth(&depth).unwrap();
         assert!(
             d.pixels
