@@ -7,7 +7,9 @@ use crate::common::{json_ok, module_cache, ocular, p, temp_dir};
 use std::path::Path;
 use std::process::Output;
 
-use common::blender::{combined, cycles_layer, depth_values, plane, write_single_part};
+use common::blender::{
+    combined, cycles_layer, depth_values, plane, uniform_rgb, write_single_part,
+};
 
 const SIZE: (usize, usize) = (16, 16);
 const N: usize = SIZE.0 * SIZE.1;
@@ -147,15 +149,7 @@ fn a_blender_multilayer_file_renders_with_its_combined_colour_and_depth() {
 fn far_focus_background_and_near_pixels_render_instead_of_failing() {
     let dir = temp_dir("depth");
     let colour = dir.join("c.exr");
-    write_single_part(
-        &colour,
-        SIZE,
-        vec![
-            plane("R", vec![1.0; N]),
-            plane("G", vec![1.0; N]),
-            plane("B", vec![1.0; N]),
-        ],
-    );
+    write_single_part(&colour, SIZE, uniform_rgb(N, [1.0; 3]));
     // Sky (Cycles' 1e10) over the whole top half and the centre; one pixel at 1 cm.
     let mut z = depth_values(SIZE, 2.0, 1e10);
     for v in z.iter_mut().take(N / 2 + SIZE.0) {
@@ -239,16 +233,9 @@ fn far_focus_background_and_near_pixels_render_instead_of_failing() {
 fn focus_beyond_the_far_point_is_reported_where_the_eye_focuses() {
     let dir = temp_dir("far-point");
     let colour = dir.join("c.exr");
-    write_single_part(
-        &colour,
-        SIZE,
-        vec![
-            plane("R", vec![1.0; N]),
-            plane("G", vec![1.0; N]),
-            plane("B", vec![1.0; N]),
-            plane("Z", depth_values(SIZE, 5.0, 1e10)),
-        ],
-    );
+    let mut planes = uniform_rgb(N, [1.0; 3]);
+    planes.push(plane("Z", depth_values(SIZE, 5.0, 1e10)));
+    write_single_part(&colour, SIZE, planes);
     let out = dir.join("out.png");
     // The myopia preset cannot relax to 5 m: its far point, by an independent paraxial
     // trace at the accommodation wavelength, is at −(paraxial refraction) dioptres.

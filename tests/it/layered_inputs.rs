@@ -4,7 +4,7 @@
 use crate::common;
 use crate::common::{ocular_run, temp_dir};
 
-use common::blender::{options, plane, write_multi_part, Plane};
+use common::blender::{options, plane, uniform_rgb, write_multi_part, Plane};
 use ocular::inputs::load;
 
 const W: usize = 16;
@@ -12,12 +12,9 @@ const H: usize = 8;
 
 fn layer(value: f32, z: impl Fn(usize) -> f32) -> Vec<Plane> {
     let n = W * H;
-    vec![
-        plane("R", vec![value; n]),
-        plane("G", vec![2.0 * value; n]),
-        plane("B", vec![3.0 * value; n]),
-        plane("Z", (0..n).map(z).collect()),
-    ]
+    let mut planes = uniform_rgb(n, [value, 2.0 * value, 3.0 * value]);
+    planes.push(plane("Z", (0..n).map(z).collect()));
+    planes
 }
 
 #[test]

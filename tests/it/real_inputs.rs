@@ -7,8 +7,8 @@ use crate::common;
 use crate::common::temp_dir;
 
 use common::blender::{
-    combined, cycles_layer, depth_values, half_plane, options, plane, write_multi_part,
-    write_single_part, write_views,
+    combined, cycles_layer, depth_values, half_plane, options, plane, uniform_rgb,
+    write_multi_part, write_single_part, write_views,
 };
 use ocular::inputs::{self, FileInputOptions};
 
@@ -200,14 +200,7 @@ fn depth_is_never_taken_from_the_wrong_pass_or_part() {
         &parts,
         SIZE,
         vec![
-            (
-                "ViewLayer.Combined",
-                vec![
-                    plane("R", vec![0.7; n]),
-                    plane("G", vec![0.8; n]),
-                    plane("B", vec![0.9; n]),
-                ],
-            ),
+            ("ViewLayer.Combined", uniform_rgb(n, [0.7, 0.8, 0.9])),
             (
                 "ViewLayer.Depth",
                 vec![plane("Z", depth_values(SIZE, 5.0, 1e10))],
@@ -225,15 +218,7 @@ fn depth_is_never_taken_from_the_wrong_pass_or_part() {
 
     // Mist-only and Normal-only files are not depth: refused, listing what is there.
     let colour = dir.join("rgb.exr");
-    write_single_part(
-        &colour,
-        SIZE,
-        vec![
-            plane("R", vec![1.0; n]),
-            plane("G", vec![1.0; n]),
-            plane("B", vec![1.0; n]),
-        ],
-    );
+    write_single_part(&colour, SIZE, uniform_rgb(n, [1.0; 3]));
     for (name, planes) in [
         ("mist", vec![plane("ViewLayer.Mist.Z", vec![0.5; n])]),
         (
@@ -269,17 +254,10 @@ fn depth_is_never_taken_from_the_wrong_pass_or_part() {
     }
     // The Blender "Z buffer" EXR: R, G, B, A, Z in one part; here the Z = 1 trap.
     let zbuf = dir.join("zbuf.exr");
-    write_single_part(
-        &zbuf,
-        SIZE,
-        vec![
-            plane("R", vec![0.2; n]),
-            plane("G", vec![0.3; n]),
-            plane("B", vec![0.4; n]),
-            plane("A", vec![1.0; n]),
-            plane("Z", vec![1.0; n]),
-        ],
-    );
+    let mut planes = uniform_rgb(n, [0.2, 0.3, 0.4]);
+    planes.push(plane("A", vec![1.0; n]));
+    planes.push(plane("Z", vec![1.0; n]));
+    write_single_part(&zbuf, SIZE, planes);
     let got = inputs::load(&options(&zbuf)).unwrap();
     assert_eq!(got.depth_report.constant_m, Some(1.0));
     assert!(
@@ -441,16 +419,9 @@ fn pictures_are_decoded_from_srgb_and_scaled_to_white() {
     // EXR colour is cd/m² unless --white-cdm2 says what 1.0 is (Blender's scene-linear
     // values are relative).
     let exr = dir.join("c.exr");
-    write_single_part(
-        &exr,
-        (4, 2),
-        vec![
-            plane("R", vec![0.5; 8]),
-            plane("G", vec![0.25; 8]),
-            plane("B", vec![1.0; 8]),
-            plane("Z", vec![3.0; 8]),
-        ],
-    );
+    let mut planes = uniform_rgb(8, [0.5, 0.25, 1.0]);
+    planes.push(plane("Z", vec![3.0; 8]));
+    write_single_part(&exr, (4, 2), planes);
     let mut o = options(&exr);
     assert_eq!(
         inputs::load(&o).unwrap().color.pixels[0],

@@ -102,6 +102,15 @@ pub fn write_views(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, &str, 
     .unwrap();
 }
 
+/// R, G and B planes of `n` pixels, each one value throughout.
+pub fn uniform_rgb(n: usize, [r, g, b]: [f32; 3]) -> Vec<Plane> {
+    vec![
+        plane("R", vec![r; n]),
+        plane("G", vec![g; n]),
+        plane("B", vec![b; n]),
+    ]
+}
+
 /// `<layer>.Combined.{R,G,B,A}` with distinct, recognisable values: R = `base` + x, G = 2·base,
 /// B = 3·base, A = 1.
 pub fn combined(layer: &str, (w, h): (usize, usize), base: f32) -> Vec<Plane> {
