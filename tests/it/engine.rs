@@ -6,6 +6,7 @@
 
 use crate::common;
 
+use common::pixels::max_rgb_difference;
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};
 use ocular::render::blend::{BlendMode, BlendSettings};
@@ -288,12 +289,6 @@ fn early_exit_changes_the_image_by_less_than_epsilon() {
         let mut splatter = Splatter::new(&ctx, grid_focused(4.0), settings).unwrap();
         render(&mut splatter, &frame, view).color
     };
-    let worst = |a: &[[f32; 4]], b: &[[f32; 4]]| {
-        a.iter()
-            .zip(b)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max)
-    };
     let brightest = 8.0 * 0.9;
     for (blend, name) in [
         (BlendSettings::default(), "depth groups"),
@@ -301,7 +296,7 @@ fn early_exit_changes_the_image_by_less_than_epsilon() {
     ] {
         let exact = run(0.0, blend);
         for epsilon in [1e-3f32, 0.3] {
-            let change = worst(&exact, &run(epsilon, blend));
+            let change = max_rgb_difference(&exact, &run(epsilon, blend));
             let bound = 2.0 * epsilon / (1.0 - epsilon) * brightest;
             eprintln!("{name}, ε = {epsilon}: worst change {change:.2e} (bound {bound:.2e})");
             assert!(change <= bound, "{name}, ε = {epsilon}: {change}");
@@ -372,11 +367,7 @@ fn convolve_walks_agree() {
     ] {
         let pixels = run(ConvolveWalk::Pixels, blend, grid, layered);
         let visits = run(ConvolveWalk::Visits, blend, grid, layered);
-        let worst = pixels
-            .iter()
-            .zip(&visits)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = max_rgb_difference(&pixels, &visits);
         eprintln!("{name}: worst difference between the walks {worst:.2e}");
         assert!(worst <= 1e-5 * 4.0, "{name}: the walks differ by {worst}");
         let mean: f32 = pixels.iter().map(|p| p[1]).sum::<f32>() / pixels.len() as f32;
@@ -489,12 +480,7 @@ fn a_scene_frame_on_the_gpu_matches_the_host_round_trip() {
                 scene_view(),
             )
             .unwrap();
-        let worst = got
-            .color
-            .iter()
-            .zip(&expected.color)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = max_rgb_difference(&got.color, &expected.color);
         eprintln!("largest difference GPU-resident vs host round trip: {worst:e}");
         assert_eq!(got.color.len(), expected.color.len());
         assert!(worst == 0.0, "largest difference {worst}");

@@ -7,6 +7,7 @@
 
 use crate::common;
 
+use common::pixels::max_rgb_difference;
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};
 use ocular::render::blend::BlendSettings;
@@ -84,14 +85,6 @@ fn splat_on_gpu(
     splatter.render_recorded(&mut frame, view()).unwrap()
 }
 
-fn worst(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
-    assert_eq!(a.len(), b.len());
-    a.iter()
-        .zip(b)
-        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-        .fold(0.0f32, f32::max)
-}
-
 /// The 2-layer frame peeled on the GPU gives the same image as the layers read back,
 /// post-processed on the host and uploaded (the same draws and the same f32 arithmetic — one
 /// division by the coverage per channel, the same comparisons — so the bar is exact
@@ -116,7 +109,7 @@ fn a_peeled_scene_on_the_gpu_matches_the_host_round_trip() {
         assert!(covered > 100, "the hidden layer is (nearly) empty: no test");
         let expected = splat_host(&mut via_host, state, &layers[0], &[&layers[1]]);
         let got = splat_on_gpu(&ctx, &mut raster, &mut on_gpu, state);
-        let difference = worst(&got.color, &expected.color);
+        let difference = max_rgb_difference(&got.color, &expected.color);
         eprintln!("largest difference GPU-peeled vs host round trip: {difference:e}");
         assert!(difference == 0.0, "largest difference {difference}");
 
@@ -132,7 +125,7 @@ fn a_peeled_scene_on_the_gpu_matches_the_host_round_trip() {
             (&visible_only, "layer 1 missing"),
             (&swapped, "layers swapped"),
         ] {
-            let change = worst(&got.color, &control.color);
+            let change = max_rgb_difference(&got.color, &control.color);
             eprintln!("{name}: largest difference {change:e} (brightest {brightest:e})");
             assert!(
                 change > 1e-3 * brightest,

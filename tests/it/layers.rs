@@ -7,6 +7,7 @@ use crate::common;
 
 use std::path::Path;
 
+use common::pixels::max_rgb_difference;
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::DioptreAxis;
 use ocular::render::blend::DEFAULT_GROUP_TOLERANCE_D;
@@ -212,20 +213,14 @@ fn an_empty_hidden_layer_changes_nothing() {
     let one = splat(std::slice::from_ref(&visible));
     let two = splat(&[visible.clone(), empty.clone()]);
     let peak = one.iter().map(|p| p[1]).fold(0.0f32, f32::max);
-    let change = |a: &[[f32; 4]], b: &[[f32; 4]]| {
-        a.iter()
-            .zip(b)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max)
-    };
-    let worst = change(&one, &two);
+    let worst = max_rgb_difference(&one, &two);
     eprintln!("empty hidden layer: largest change {worst:e} of a peak {peak}");
     assert!(worst <= 1e-6 * peak);
     // Negative control: the empty pixels taken as black surfaces far away (not skipped)
     // darken the card's blurred edge.
     let mut black = empty;
     black.depth_m.iter_mut().for_each(|d| *d = 1e6);
-    let darkened = change(&one, &splat(&[visible, black]));
+    let darkened = max_rgb_difference(&one, &splat(&[visible, black]));
     eprintln!("black far layer: largest change {darkened:e}");
     assert!(
         darkened > 0.05 * peak,

@@ -7,6 +7,7 @@
 //! `cargo test --release --test it off_axis_runtime:: -- --nocapture`.
 
 use crate::common;
+use common::pixels::max_rgb_difference;
 
 use ocular::eye::file::resolve;
 use ocular::psf::axes::Screen;
@@ -138,11 +139,7 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
             },
         );
         let other = r.render(&input, state, Method::Splat).unwrap().color;
-        let worst = other
-            .iter()
-            .zip(&splat)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = max_rgb_difference(&other, &splat);
         assert!(
             worst <= 1e-6,
             "tile size {tile_size} changes the image by {worst:e}"
@@ -162,11 +159,7 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
             },
         );
         let pixels = r.render(&input, state, Method::Splat).unwrap().color;
-        let worst = pixels
-            .iter()
-            .zip(&splat)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = max_rgb_difference(&pixels, &splat);
         eprintln!("off axis: worst difference between the walks {worst:.2e}");
         assert!(
             worst <= 1e-5,

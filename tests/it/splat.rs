@@ -4,6 +4,7 @@
 
 use crate::common;
 
+use common::pixels::{max_rgb_difference, psnr};
 use common::splat_cpu;
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::gpu::texture_probe::TextureProbe;
@@ -91,31 +92,6 @@ fn splat(
             keep,
         )
         .unwrap()
-}
-
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let mse: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(p, q)| {
-            (0..3)
-                .map(|c| (f64::from(p[c]) - f64::from(q[c])).powi(2))
-                .sum::<f64>()
-        })
-        .sum::<f64>()
-        / (3 * a.len()) as f64;
-    if mse == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (1.0 / mse).log10()
-    }
-}
-
-fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
-    a.iter()
-        .zip(b)
-        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] - q[c]).abs()))
-        .fold(0.0, f32::max)
 }
 
 /// Smooth, textured colour in [0.05, 0.95].
@@ -545,7 +521,7 @@ fn occlusion_is_ordered_like_the_ground_truth() {
         let db = psnr(&out.color, &truth);
         eprintln!(
             "{label}: PSNR vs ground truth {db:.2} dB, max diff {:.2e}",
-            max_abs_diff(&out.color, &truth)
+            max_rgb_difference(&out.color, &truth)
         );
         assert!(db >= 45.0, "{label}: {db:.2}");
         let row = |x: usize| out.color[45 * 160 + x];
@@ -756,12 +732,7 @@ fn tile_sizes_agree_and_frames_are_deterministic() {
             &scene,
             false,
         );
-        let worst = other
-            .color
-            .iter()
-            .zip(&base.color)
-            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
-            .fold(0.0f32, f32::max);
+        let worst = max_rgb_difference(&other.color, &base.color);
         eprintln!("tile size {tile_size}: largest difference {worst:e}");
         assert_eq!(
             other.color, base.color,

@@ -4,6 +4,7 @@
 //! radius is exercised.
 
 use crate::common;
+use common::pixels::psnr;
 
 use ocular::eye::Eye;
 use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
@@ -13,20 +14,6 @@ use ocular::psf::grid::{kernels_from_columns, no_progress};
 use ocular::psf::plan::{plan_for_scene, SceneNeeds};
 use ocular::render::reference;
 use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
-
-fn psnr(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let mse: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(p, q)| {
-            (0..3)
-                .map(|c| (f64::from(p[c]) - f64::from(q[c])).powi(2))
-                .sum::<f64>()
-        })
-        .sum::<f64>()
-        / (3 * a.len()) as f64;
-    10.0 * (1.0 / mse.max(1e-30)).log10()
-}
 
 fn texture(x: u32, y: u32, seed: f32) -> [f32; 3] {
     let (x, y) = (x as f32, y as f32);

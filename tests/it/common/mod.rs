@@ -118,6 +118,7 @@ pub fn refused(out: &Output, words: &[&str]) -> String {
 }
 
 pub mod blender;
+pub mod pixels;
 pub mod scenes;
 pub mod splat_cpu;
 pub mod spots;
