@@ -41,26 +41,37 @@ fn j_series_small(nmax: usize, x: f64, out: &mut [f64]) {
     }
 }
 
-/// J_0(x) … J_nmax(x) into `out[0..=nmax]`, for any finite x (negative x via parity).
-pub fn bessel_j_sequence(nmax: usize, x: f64, out: &mut [f64]) {
-    assert!(out.len() > nmax, "bessel_j_sequence: out too short");
-    let out = &mut out[..=nmax];
+/// The arguments both sequences treat alike: non-finite x (all 0), x < 0 (the sequence at −x,
+/// odd orders negated, by parity) and x = 0 (1, 0, 0, …). True where `out` is filled.
+fn special_argument(
+    nmax: usize,
+    x: f64,
+    out: &mut [f64],
+    sequence: fn(usize, f64, &mut [f64]),
+) -> bool {
     if !x.is_finite() {
         out.iter_mut().for_each(|v| *v = 0.0);
-        return;
-    }
-    if x < 0.0 {
-        bessel_j_sequence(nmax, -x, out);
+    } else if x < 0.0 {
+        sequence(nmax, -x, out);
         for (n, v) in out.iter_mut().enumerate() {
             if n % 2 == 1 {
                 *v = -*v;
             }
         }
-        return;
-    }
-    if x == 0.0 {
+    } else if x == 0.0 {
         out.iter_mut().for_each(|v| *v = 0.0);
         out[0] = 1.0;
+    } else {
+        return false;
+    }
+    true
+}
+
+/// J_0(x) … J_nmax(x) into `out[0..=nmax]`, for any finite x (negative x via parity).
+pub fn bessel_j_sequence(nmax: usize, x: f64, out: &mut [f64]) {
+    assert!(out.len() > nmax, "bessel_j_sequence: out too short");
+    let out = &mut out[..=nmax];
+    if special_argument(nmax, x, out, bessel_j_sequence) {
         return;
     }
     if x < 1e-3 {
@@ -115,22 +126,7 @@ pub fn bessel_j(n: i32, x: f64) -> f64 {
 pub fn spherical_j_sequence(kmax: usize, x: f64, out: &mut [f64]) {
     assert!(out.len() > kmax, "spherical_j_sequence: out too short");
     let out = &mut out[..=kmax];
-    if !x.is_finite() {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        return;
-    }
-    if x < 0.0 {
-        spherical_j_sequence(kmax, -x, out);
-        for (k, v) in out.iter_mut().enumerate() {
-            if k % 2 == 1 {
-                *v = -*v;
-            }
-        }
-        return;
-    }
-    if x == 0.0 {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        out[0] = 1.0;
+    if special_argument(kmax, x, out, spherical_j_sequence) {
         return;
     }
     if x < 1e-3 {

@@ -376,6 +376,13 @@ fn synthesize(
     let exact_cost = keys.len() as f64 * work + PIXEL_WEIGHT * pixels * c_count as f64 * 2.2;
     let table_cost =
         table_nodes as f64 * work + PIXEL_WEIGHT * pixels * c_count as f64 * pixel_taps(rule.taps);
+    let symmetric = SymmetricGrid {
+        n,
+        pitch: p,
+        c_count,
+        degree: rf.degree,
+        parallel: req.parallel,
+    };
     if exact && exact_cost <= table_cost {
         let mut index = vec![u32::MAX; kmax];
         for (i, &k) in keys.iter().enumerate() {
@@ -398,15 +405,7 @@ fn synthesize(
             out.copy_from_slice(&g[k * c_count..(k + 1) * c_count]);
             true
         };
-        symmetric_fill(
-            &mut intensity,
-            n,
-            p,
-            c_count,
-            rf.degree,
-            req.parallel,
-            radial,
-        );
+        symmetric.fill(&mut intensity, radial);
         (intensity, 0.0, 0, keys.len(), t2)
     } else {
         let table = AmplitudeTable::new(rf, r_max, rule, step, req.parallel);
@@ -415,15 +414,7 @@ fn synthesize(
             let radial = |a: i64, b: i64, out: &mut [Complex64]| {
                 table.radial(p * (a as f64).hypot(b as f64), out)
             };
-            symmetric_fill(
-                &mut intensity,
-                n,
-                p,
-                c_count,
-                rf.degree,
-                req.parallel,
-                radial,
-            );
+            symmetric.fill(&mut intensity, radial);
         } else {
             // Visit pixels in order of radius: neighbours then read the same table rows,
             // which stay in cache (the table itself is usually far larger than the cache).
@@ -454,60 +445,72 @@ fn synthesize(
     }
 }
 
-/// Fill a grid centred on the axis four mirror images at a time: (a, b), (−a, −b), (a, −b),
-/// (−a, b) in pixel offsets share their radial values. `radial(a, b, g)` writes the radial
-/// values at the radius of offset (a, b) (false: outside, leave 0).
-fn symmetric_fill(
-    out: &mut [f64],
+/// An n × n grid of `pitch` centred on the axis, whose radial values have `c_count`
+/// combinations up to `degree`, filled four mirror images at a time.
+#[derive(Clone, Copy)]
+struct SymmetricGrid {
     n: usize,
     pitch: f64,
     c_count: usize,
     degree: u32,
     parallel: bool,
-    radial: impl Fn(i64, i64, &mut [Complex64]) -> bool + Sync,
-) {
-    let half = (n / 2) as i64;
-    let lo = -half;
-    let hi = n as i64 - 1 - half;
-    let amax = half.max(hi);
-    // one task per b ≥ 0: returns the rows for +b (row half − b) and −b (row half + b)
-    let rows_for = |b: i64| -> (Vec<f64>, Vec<f64>) {
-        let mut g = vec![Complex64::default(); c_count];
-        let mut up = vec![0.0; n];
-        let mut down = vec![0.0; n];
-        for a in 0..=amax {
-            if !radial(a, b, &mut g) {
-                continue;
-            }
-            let u = RadialAmplitude::quad_sums(&g, degree, a as f64 * pitch, b as f64 * pitch);
-            // u: (a, b), (−a, −b), (a, −b), (−a, b)
-            let put = |row: &mut [f64], aa: i64, v: Complex64| {
-                if (lo..=hi).contains(&aa) {
-                    row[(aa + half) as usize] = v.norm_sqr();
+}
+
+impl SymmetricGrid {
+    /// Fills `out` four mirror images at a time: (a, b), (−a, −b), (a, −b), (−a, b) in pixel
+    /// offsets share their radial values. `radial(a, b, g)` writes the radial values at the
+    /// radius of offset (a, b) (false: outside, leave 0).
+    fn fill(self, out: &mut [f64], radial: impl Fn(i64, i64, &mut [Complex64]) -> bool + Sync) {
+        let SymmetricGrid {
+            n,
+            pitch,
+            c_count,
+            degree,
+            parallel,
+        } = self;
+        let half = (n / 2) as i64;
+        let lo = -half;
+        let hi = n as i64 - 1 - half;
+        let amax = half.max(hi);
+        // one task per b ≥ 0: returns the rows for +b (row half − b) and −b (row half + b)
+        let rows_for = |b: i64| -> (Vec<f64>, Vec<f64>) {
+            let mut g = vec![Complex64::default(); c_count];
+            let mut up = vec![0.0; n];
+            let mut down = vec![0.0; n];
+            for a in 0..=amax {
+                if !radial(a, b, &mut g) {
+                    continue;
                 }
-            };
-            put(&mut up, a, u[0]);
-            put(&mut up, -a, u[3]);
-            put(&mut down, -a, u[1]);
-            put(&mut down, a, u[2]);
-        }
-        (up, down)
-    };
-    let bs: Vec<i64> = (0..=amax).collect();
-    let rows: Vec<(Vec<f64>, Vec<f64>)> = if parallel {
-        bs.par_iter().map(|&b| rows_for(b)).collect()
-    } else {
-        bs.iter().map(|&b| rows_for(b)).collect()
-    };
-    for (b, (up, down)) in bs.iter().zip(rows) {
-        // +y is up: y = +b is row half − b (needs b ≤ half), y = −b is row half + b (b ≤ hi)
-        if *b <= half {
-            let r = (half - b) as usize;
-            out[r * n..(r + 1) * n].copy_from_slice(&up);
-        }
-        if *b <= hi {
-            let r = (half + b) as usize;
-            out[r * n..(r + 1) * n].copy_from_slice(&down);
+                let u = RadialAmplitude::quad_sums(&g, degree, a as f64 * pitch, b as f64 * pitch);
+                // u: (a, b), (−a, −b), (a, −b), (−a, b)
+                let put = |row: &mut [f64], aa: i64, v: Complex64| {
+                    if (lo..=hi).contains(&aa) {
+                        row[(aa + half) as usize] = v.norm_sqr();
+                    }
+                };
+                put(&mut up, a, u[0]);
+                put(&mut up, -a, u[3]);
+                put(&mut down, -a, u[1]);
+                put(&mut down, a, u[2]);
+            }
+            (up, down)
+        };
+        let bs: Vec<i64> = (0..=amax).collect();
+        let rows: Vec<(Vec<f64>, Vec<f64>)> = if parallel {
+            bs.par_iter().map(|&b| rows_for(b)).collect()
+        } else {
+            bs.iter().map(|&b| rows_for(b)).collect()
+        };
+        for (b, (up, down)) in bs.iter().zip(rows) {
+            // +y is up: y = +b is row half − b (needs b ≤ half), y = −b is row half + b (b ≤ hi)
+            if *b <= half {
+                let r = (half - b) as usize;
+                out[r * n..(r + 1) * n].copy_from_slice(&up);
+            }
+            if *b <= hi {
+                let r = (half + b) as usize;
+                out[r * n..(r + 1) * n].copy_from_slice(&down);
+            }
         }
     }
 }
