@@ -84,18 +84,9 @@ impl ChannelOptics {
         );
         let lam_um = wavelength_nm * 1e-3;
         let order = order_for_len(alpha_um.len());
-        let mut slopes = Vec::new();
-        let rings = 12 + 2 * order as usize;
-        for ring in 1..=rings {
-            let rho = ring as f64 / rings as f64;
-            let spokes = 8 + 4 * ring;
-            for k in 0..spokes {
-                let th = 2.0 * PI * k as f64 / spokes as f64;
-                let (x, y) = (rho * th.cos(), rho * th.sin());
-                let (gx, gy) = wavefront_gradient(&alpha_um, x, y);
-                slopes.push(([x, y], [gx / lam_um, gy / lam_um]));
-            }
-        }
+        let slopes = ring_gradients(&alpha_um, 12 + 2 * order as usize)
+            .map(|(p, (gx, gy))| (p, [gx / lam_um, gy / lam_um]))
+            .collect();
         ChannelOptics {
             wavelength_nm,
             pupil_mm,
@@ -305,4 +296,22 @@ fn measure_channels(
         channels.push(ch);
     }
     Ok(channels.try_into().expect("three channels"))
+}
+
+/// The wavefront's gradient at points of the unit pupil on `rings` evenly spaced rings of
+/// 8 + 4·ring spokes each (ring by ring, spoke by spoke): where slopes and ray extents are
+/// sampled.
+pub(super) fn ring_gradients(
+    alpha_um: &[f64],
+    rings: usize,
+) -> impl Iterator<Item = ([f64; 2], (f64, f64))> + '_ {
+    (1..=rings).flat_map(move |ring| {
+        let rho = ring as f64 / rings as f64;
+        let spokes = 8 + 4 * ring;
+        (0..spokes).map(move |k| {
+            let th = 2.0 * PI * k as f64 / spokes as f64;
+            let (x, y) = (rho * th.cos(), rho * th.sin());
+            ([x, y], wavefront_gradient(alpha_um, x, y))
+        })
+    })
 }

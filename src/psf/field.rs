@@ -6,13 +6,11 @@
 use super::axes::{GridAxes, KernelSettings, Screen};
 use super::cache::{grid_key, key_of};
 use super::defocus::ColumnOptics;
-use super::grid::{kernels_from_columns, GridReport, Progress, Stage};
+use super::grid::{kernels_from_columns, measure_columns, GridReport, Progress};
 use super::kernels::KernelGrid;
 use crate::eye::field::check_field_deg;
 use crate::eye::Eye;
 use crate::{Error, Result};
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Accommodates `eye` for (pupil, focus) on axis and measures it at each wavelength for the
@@ -111,24 +109,7 @@ pub fn compute_field_grid(
     axes.validate().map_err(Error::input)?;
     settings.validate().map_err(Error::input)?;
     let t0 = Instant::now();
-    let pairs: Vec<(f64, f64)> = axes
-        .pupils_mm
-        .iter()
-        .flat_map(|&p| axes.focus_d.iter().map(move |&f| (p, f)))
-        .collect();
-    let done = AtomicUsize::new(0);
-    let columns = pairs
-        .par_iter()
-        .map(|&(p, f)| {
-            let c = field_column(eye, p, f, axes.wavelengths_nm, settings, field_deg);
-            progress(
-                Stage::Optics,
-                done.fetch_add(1, Ordering::Relaxed) + 1,
-                pairs.len(),
-            );
-            c
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let columns = measure_columns(eye, axes, settings, field_deg, progress)?;
     let seconds_optics = t0.elapsed().as_secs_f64();
     let (grid, mut report) = kernels_from_columns(&columns, axes, screen, settings, progress)?;
     report.seconds_optics = seconds_optics;

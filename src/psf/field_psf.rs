@@ -16,13 +16,13 @@
 //! the shared β expansion of the ENZ path).
 
 use super::axes::{KernelSettings, Screen};
-use super::defocus::ChannelOptics;
+use super::defocus::{ring_gradients, ChannelOptics};
 use super::field_shape::FieldShape;
 use super::project::{
     crop, cropped_psf_at_f, pitch_lambda_na, CroppedPsf, PsfMethod, MAX_PSF_SIDE,
 };
 use crate::optics::fft_psf::psf_by_fft;
-use crate::optics::zernike::{osa_index, wavefront_gradient};
+use crate::optics::zernike::osa_index;
 use crate::Result;
 use std::f64::consts::PI;
 
@@ -44,19 +44,9 @@ pub fn cropped_psf(
 fn ray_extent(alpha_um: &[f64], wavelength_nm: f64, f: f64) -> f64 {
     let lam_um = wavelength_nm * 1e-3;
     let k = f / PI;
-    let mut worst = 0.0f64;
-    let rings = 24;
-    for ring in 1..=rings {
-        let rho = ring as f64 / rings as f64;
-        let spokes = 8 + 4 * ring;
-        for j in 0..spokes {
-            let th = 2.0 * PI * j as f64 / spokes as f64;
-            let (x, y) = (rho * th.cos(), rho * th.sin());
-            let (gx, gy) = wavefront_gradient(alpha_um, x, y);
-            worst = worst.max((gx / lam_um + k * x).abs().max((gy / lam_um + k * y).abs()));
-        }
-    }
-    worst
+    ring_gradients(alpha_um, 24).fold(0.0f64, |worst, ([x, y], (gx, gy))| {
+        worst.max((gx / lam_um + k * x).abs().max((gy / lam_um + k * y).abs()))
+    })
 }
 
 /// The PSF of an off-axis channel for an object at `object_d` dioptres, on the physical

@@ -98,6 +98,18 @@ pub fn columns_for(
     axes.validate().map_err(Error::input)?;
     settings.validate().map_err(Error::input)?;
     eye.validate()?;
+    measure_columns(eye, axes, settings, [0.0, 0.0], progress)
+}
+
+/// The eye focused (on axis) for every (pupil, focus) pair, pupil-major, and measured for the
+/// field direction `field_deg`, in parallel; the inputs are checked by the caller.
+pub(super) fn measure_columns(
+    eye: &Eye,
+    axes: &GridAxes,
+    settings: &KernelSettings,
+    field_deg: [f64; 2],
+    progress: Progress,
+) -> Result<Vec<ColumnOptics>> {
     let pairs: Vec<(f64, f64)> = axes
         .pupils_mm
         .iter()
@@ -107,7 +119,7 @@ pub fn columns_for(
     pairs
         .par_iter()
         .map(|&(p, f)| {
-            let c = ColumnOptics::new(eye, p, f, axes.wavelengths_nm, settings);
+            let c = ColumnOptics::new_in_field(eye, p, f, axes.wavelengths_nm, settings, field_deg);
             progress(
                 Stage::Optics,
                 done.fetch_add(1, Ordering::Relaxed) + 1,
