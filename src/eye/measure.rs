@@ -17,7 +17,7 @@ use super::error::EyeError;
 use super::fit::PupilPattern;
 use super::paraxial::{paraxial, Paraxial};
 use super::surface::{dot, V3};
-use super::system::OpticalSystem;
+use super::system::{OpticalSystem, MAX_SURFACES};
 use super::trace::{trace_range, Ray};
 use crate::optics::zernike::{num_terms, osa_index};
 use serde::Serialize;
@@ -163,28 +163,27 @@ impl Measurer {
         pupil_mm: f64,
         object_distance_m: Option<f64>,
     ) -> Result<Measurement, EyeError> {
-        check_inputs(wavelength_nm, pupil_mm, object_distance_m)?;
-        let n = sys.indices(wavelength_nm);
-        let ns = sys.surfaces.len();
-        let nv = n[ns];
-        let px = paraxial(sys, wavelength_nm, 0.0);
-        let py = paraxial(sys, wavelength_nm, 90.0);
-        let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
-        let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
-        let radius = pupil_mm / 2.0;
-        let launch = launcher(object_distance_m, radius, ep_z, first_z(sys))?;
-
-        let mut chief = launch(0.0, 0.0);
-        trace_range(sys, &n, &mut chief, 0..ns).map_err(|v| {
-            EyeError::Invalid(format!(
-                "chief ray vignetted ({v:?}); the eye cannot image the axis"
-            ))
-        })?;
-        let image = chief.at(chief.to_plane(sys.retina_z_mm));
-        let s_xp = chief.to_plane(xp_z);
-        let xp_centre = chief.at(s_xp);
-        let rs = dist(image, xp_centre);
-        let l_ref = chief.opl_mm + nv * s_xp;
+        let Chief {
+            n,
+            ns,
+            nv,
+            px,
+            py,
+            ep_z,
+            xp_z,
+            launch,
+            chief,
+            image,
+            xp_centre,
+            rs,
+            l_ref,
+        } = chief_ray(
+            sys,
+            wavelength_nm,
+            pupil_mm,
+            object_distance_m,
+            "; the eye cannot image the axis",
+        )?;
 
         let np = self.pattern.points.len();
         let mut w = vec![0.0; np];
@@ -265,22 +264,16 @@ impl Measurer {
         object_distance_m: Option<f64>,
         out: &mut [f64],
     ) -> Result<(), EyeError> {
-        check_inputs(wavelength_nm, pupil_mm, object_distance_m)?;
-        let n = sys.indices(wavelength_nm);
-        let ns = sys.surfaces.len();
-        let nv = n[ns];
-        let px = paraxial(sys, wavelength_nm, 0.0);
-        let py = paraxial(sys, wavelength_nm, 90.0);
-        let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
-        let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
-        let launch = launcher(object_distance_m, pupil_mm / 2.0, ep_z, first_z(sys))?;
-        let mut chief = launch(0.0, 0.0);
-        trace_range(sys, &n, &mut chief, 0..ns)
-            .map_err(|v| EyeError::Invalid(format!("chief ray vignetted ({v:?})")))?;
-        let image = chief.at(chief.to_plane(sys.retina_z_mm));
-        let s_xp = chief.to_plane(xp_z);
-        let rs = dist(image, chief.at(s_xp));
-        let l_ref = chief.opl_mm + nv * s_xp;
+        let Chief {
+            n,
+            ns,
+            nv,
+            launch,
+            image,
+            rs,
+            l_ref,
+            ..
+        } = chief_ray(sys, wavelength_nm, pupil_mm, object_distance_m, "")?;
         let np = self.pattern.points.len();
         let mut w = vec![0.0; np];
         for (i, p) in self.pattern.points.iter().enumerate() {
@@ -294,6 +287,70 @@ impl Measurer {
         self.pattern.fit(&w, out);
         Ok(())
     }
+}
+
+/// What both measurements start from: the media, the paraxial pupils, the launcher over the
+/// entrance pupil, and the chief ray traced to the retina with the reference sphere it gives.
+struct Chief<L> {
+    n: [f64; MAX_SURFACES + 1],
+    ns: usize,
+    /// The index of the medium before the retina.
+    nv: f64,
+    px: Paraxial,
+    py: Paraxial,
+    ep_z: f64,
+    xp_z: f64,
+    launch: L,
+    chief: Ray,
+    image: V3,
+    xp_centre: V3,
+    /// The reference sphere's radius (image to exit-pupil centre) and the chief ray's optical
+    /// path to it.
+    rs: f64,
+    l_ref: f64,
+}
+
+/// The inputs checked and the chief ray traced; `vignetted` ends the error where it is
+/// vignetted.
+fn chief_ray(
+    sys: &OpticalSystem,
+    wavelength_nm: f64,
+    pupil_mm: f64,
+    object_distance_m: Option<f64>,
+    vignetted: &str,
+) -> Result<Chief<impl Fn(f64, f64) -> Ray>, EyeError> {
+    check_inputs(wavelength_nm, pupil_mm, object_distance_m)?;
+    let n = sys.indices(wavelength_nm);
+    let ns = sys.surfaces.len();
+    let nv = n[ns];
+    let px = paraxial(sys, wavelength_nm, 0.0);
+    let py = paraxial(sys, wavelength_nm, 90.0);
+    let ep_z = 0.5 * (px.entrance_pupil_z_mm + py.entrance_pupil_z_mm);
+    let xp_z = 0.5 * (px.exit_pupil_z_mm + py.exit_pupil_z_mm);
+    let launch = launcher(object_distance_m, pupil_mm / 2.0, ep_z, first_z(sys))?;
+    let mut chief = launch(0.0, 0.0);
+    trace_range(sys, &n, &mut chief, 0..ns)
+        .map_err(|v| EyeError::Invalid(format!("chief ray vignetted ({v:?}){vignetted}")))?;
+    let image = chief.at(chief.to_plane(sys.retina_z_mm));
+    let s_xp = chief.to_plane(xp_z);
+    let xp_centre = chief.at(s_xp);
+    let rs = dist(image, xp_centre);
+    let l_ref = chief.opl_mm + nv * s_xp;
+    Ok(Chief {
+        n,
+        ns,
+        nv,
+        px,
+        py,
+        ep_z,
+        xp_z,
+        launch,
+        chief,
+        image,
+        xp_centre,
+        rs,
+        l_ref,
+    })
 }
 
 /// Measures with the standard (order 6) or a higher-order pattern.

@@ -43,14 +43,23 @@ fn weights(wavelength_nm: f64) -> [f64; 4] {
     a
 }
 
+impl Medium {
+    /// The medium's row in the index tables; none for air (index 1).
+    fn row(self) -> Option<usize> {
+        match self {
+            Medium::Air => None,
+            Medium::Cornea => Some(0),
+            Medium::Aqueous => Some(1),
+            Medium::Lens => Some(2),
+            Medium::Vitreous => Some(3),
+        }
+    }
+}
+
 /// Refractive index of `medium` at `wavelength_nm` (Navarro's relaxed lens index for the lens).
 pub fn refractive_index(medium: Medium, wavelength_nm: f64) -> f64 {
-    let row = match medium {
-        Medium::Air => return 1.0,
-        Medium::Cornea => 0,
-        Medium::Aqueous => 1,
-        Medium::Lens => 2,
-        Medium::Vitreous => 3,
+    let Some(row) = medium.row() else {
+        return 1.0;
     };
     let a = weights(wavelength_nm);
     a.iter()
@@ -67,12 +76,8 @@ const ANCHOR_589: [f64; 4] = [1.376, 1.3374, 1.42, 1.336];
 /// relaxed eye's power is 0.02 D short of Navarro's 60.416 D, because the lens index the
 /// formula yields at 589.3 nm is 1.41992 rather than 1.42.
 pub fn eye_index(medium: Medium, wavelength_nm: f64) -> f64 {
-    let row = match medium {
-        Medium::Air => return 1.0,
-        Medium::Cornea => 0,
-        Medium::Aqueous => 1,
-        Medium::Lens => 2,
-        Medium::Vitreous => 3,
+    let Some(row) = medium.row() else {
+        return 1.0;
     };
     refractive_index(medium, wavelength_nm) - refractive_index(medium, 589.3) + ANCHOR_589[row]
 }
