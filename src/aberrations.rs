@@ -118,6 +118,15 @@ fn check_pupil_wavelength(file: &str, pupil: f64, wl: f64) -> Result<(), Aberrat
     Ok(())
 }
 
+/// An error at `file:line` from its message.
+fn parse_error(file: &str, line: usize) -> impl Fn(String) -> AberrationError + '_ {
+    move |message| AberrationError::Parse {
+        file: file.into(),
+        line,
+        message,
+    }
+}
+
 fn check_term(
     file: &str,
     line: usize,
@@ -125,11 +134,7 @@ fn check_term(
     m: i64,
     v: f64,
 ) -> Result<(u32, i32), AberrationError> {
-    let err = |message: String| AberrationError::Parse {
-        file: file.into(),
-        line,
-        message,
-    };
+    let err = parse_error(file, line);
     if n < 0 || n > MAX_FILE_ORDER as i64 || m.abs() > n || !is_valid_nm(n as u32, m as i32) {
         return Err(err(format!(
             "Zernike term (n, m) = ({n}, {m}) does not exist; need 0 <= n <= {MAX_FILE_ORDER}, |m| <= n, n - |m| even"
@@ -148,14 +153,10 @@ impl ZernikeSet {
     pub fn from_toml_str(text: &str, file: &str) -> Result<ZernikeSet, AberrationError> {
         let parsed: TomlFile = toml::from_str(text).map_err(|e| {
             let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(0);
-            AberrationError::Parse {
-                file: file.into(),
-                line,
-                message: format!(
-                    "{} (expected pupil_diameter_mm, wavelength_nm and [[term]] tables with n, m, um)",
-                    e.message()
-                ),
-            }
+            parse_error(file, line)(format!(
+                "{} (expected pupil_diameter_mm, wavelength_nm and [[term]] tables with n, m, um)",
+                e.message()
+            ))
         })?;
         check_pupil_wavelength(file, parsed.pupil_diameter_mm, parsed.wavelength_nm)?;
         let mut coefficients = Vec::with_capacity(parsed.term.len());
@@ -200,20 +201,17 @@ impl ZernikeSet {
                         _ => None,
                     };
                     if let Some(slot) = slot {
-                        let val = val.ok_or_else(|| AberrationError::Parse {
-                            file: file.into(),
-                            line,
-                            message: format!("{key} needs a number, got {:?}", v.trim()),
+                        let val = val.ok_or_else(|| {
+                            parse_error(file, line)(format!(
+                                "{key} needs a number, got {:?}",
+                                v.trim()
+                            ))
                         })?;
                         if slot.is_some_and(|old| old != val) {
-                            return Err(AberrationError::Parse {
-                                file: file.into(),
-                                line,
-                                message: format!(
-                                    "{key} = {val} contradicts an earlier header line ({})",
-                                    slot.unwrap_or_default()
-                                ),
-                            });
+                            return Err(parse_error(file, line)(format!(
+                                "{key} = {val} contradicts an earlier header line ({})",
+                                slot.unwrap_or_default()
+                            )));
                         }
                         *slot = Some(val);
                     }
@@ -226,11 +224,7 @@ impl ZernikeSet {
             {
                 continue;
             }
-            let err = |message: String| AberrationError::Parse {
-                file: file.into(),
-                line,
-                message,
-            };
+            let err = parse_error(file, line);
             let (a, b) = s.split_once(',').ok_or_else(|| {
                 err(format!(
                     "expected 'j,coefficient_um' (OSA index, micrometres), got {s:?}"
@@ -290,11 +284,7 @@ impl ZernikeSet {
             if s.is_empty() {
                 continue;
             }
-            let err = |message: String| AberrationError::Parse {
-                file: file.into(),
-                line,
-                message,
-            };
+            let err = parse_error(file, line);
             let (k, v) = s.split_once('=').ok_or_else(|| {
                 err(format!(
                     "expected 'Ap = mm', 'Wa = nm' or 'Z[n, m] = um', got {s:?}"

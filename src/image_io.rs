@@ -224,13 +224,23 @@ pub fn exr_rgba_bytes(image: &ImageRgba) -> std::result::Result<Vec<u8>, String>
         let p = image.pixels[position.y() * width + position.x()];
         (p[0], p[1], p[2], p[3])
     });
-    let exr_image = Image::from_encoded_channels(
+    exr_bytes(&Image::from_encoded_channels(
         (width, image.height as usize),
         deterministic_encoding(),
         channels,
-    );
+    ))
+}
+
+/// The bytes of a one-layer EXR image.
+fn exr_bytes<'c, C>(
+    image: &'c exr::image::Image<exr::image::Layer<C>>,
+) -> std::result::Result<Vec<u8>, String>
+where
+    C: exr::image::write::channels::WritableChannels<'c>,
+{
+    use exr::prelude::*;
     let mut cursor = std::io::Cursor::new(Vec::new());
-    exr_image
+    image
         .write()
         .to_buffered(&mut cursor)
         .map_err(|e| format!("cannot encode EXR: {e}"))?;
@@ -257,17 +267,13 @@ pub fn write_exr_gray(path: impl AsRef<Path>, image: &ImageGray, channel: &str) 
         .with_pixel_fn(
             |position: Vec2<usize>| (image.pixels[position.y() * width + position.x()],),
         );
-    let exr_image = Image::from_encoded_channels(
+    let bytes = exr_bytes(&Image::from_encoded_channels(
         (width, image.height as usize),
         deterministic_encoding(),
         channels,
-    );
-    let mut cursor = std::io::Cursor::new(Vec::new());
-    exr_image
-        .write()
-        .to_buffered(&mut cursor)
-        .map_err(|e| file_error(path, format!("cannot encode EXR: {e}")))?;
-    write_bytes_atomic(path, &cursor.into_inner())
+    ))
+    .map_err(|m| file_error(path, m))?;
+    write_bytes_atomic(path, &bytes)
 }
 
 /// Writes depth in metres as a single-channel EXR with the conventional channel name Z.

@@ -32,13 +32,9 @@ impl Plane {
     }
 
     pub fn along_rows(&self, taps: &[f64]) -> Plane {
-        let (w, h) = (self.width, self.height);
+        let w = self.width;
         let r = (taps.len() / 2) as isize;
-        let mut out = vec![0.0; w * h];
-        if w == 0 {
-            return Plane::new(w, h, out);
-        }
-        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        self.rows_from(|y, row| {
             let src = &self.values[y * w..(y + 1) * w];
             for (x, o) in row.iter_mut().enumerate() {
                 let mut sum = 0.0;
@@ -48,18 +44,13 @@ impl Plane {
                 }
                 *o = sum;
             }
-        });
-        Plane::new(w, h, out)
+        })
     }
 
     pub fn along_columns(&self, taps: &[f64]) -> Plane {
         let (w, h) = (self.width, self.height);
         let r = (taps.len() / 2) as isize;
-        let mut out = vec![0.0; w * h];
-        if w == 0 {
-            return Plane::new(w, h, out);
-        }
-        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        self.rows_from(|y, row| {
             for (i, t) in taps.iter().enumerate() {
                 let yy = (y as isize + i as isize - r).clamp(0, h as isize - 1) as usize;
                 let src = &self.values[yy * w..(yy + 1) * w];
@@ -67,7 +58,19 @@ impl Plane {
                     *o += t * s;
                 }
             }
-        });
+        })
+    }
+
+    /// A plane of this one's size whose row y (zeroed first) `fill(y, row)` writes, rows in
+    /// parallel.
+    fn rows_from(&self, fill: impl Fn(usize, &mut [f64]) + Sync + Send) -> Plane {
+        let (w, h) = (self.width, self.height);
+        let mut out = vec![0.0; w * h];
+        if w > 0 {
+            out.par_chunks_mut(w)
+                .enumerate()
+                .for_each(|(y, row)| fill(y, row));
+        }
         Plane::new(w, h, out)
     }
 }
