@@ -41,6 +41,49 @@ pub(crate) fn out_of_memory(what: &str, bytes: u64) -> GpuError {
     }
 }
 
+/// What a failed `call` creating `what` (e.g. `image "psf texture"`) of `bytes` means: running
+/// out of memory names the resource and its size, so that the user can shrink it.
+pub(crate) fn creation_error(
+    call: &'static str,
+    what: &str,
+    bytes: u64,
+    e: vk::Result,
+) -> GpuError {
+    match e {
+        vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
+            out_of_memory(what, bytes)
+        }
+        e => GpuError::Vulkan { call, result: e },
+    }
+}
+
+/// Memory for a just-created buffer or image, counted in [`Context::allocations`]; `what` names
+/// the resource in errors as in [`creation_error`].
+pub(crate) fn allocate(
+    shared: &DeviceShared,
+    (name, what, bytes): (&str, &str, u64),
+    requirements: vk::MemoryRequirements,
+    location: MemoryLocation,
+    linear: bool,
+) -> GpuResult<Allocation> {
+    shared
+        .allocations
+        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    shared
+        .allocator()
+        .allocate(&AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        })
+        .map_err(|e| match e {
+            gpu_allocator::AllocationError::OutOfMemory => out_of_memory(what, bytes),
+            e => GpuError::Unsupported(format!("allocating {what}: {e}")),
+        })
+}
+
 impl Context {
     /// Buffers and images allocated on this device so far, by anyone: a steady-state frame
     /// leaves it unchanged.
@@ -73,41 +116,24 @@ impl Buffer {
             .size(size_bytes)
             .usage(usage)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
+        let what = format!("buffer \"{name}\"");
         // SAFETY: valid create info on a live device.
-        let raw = unsafe { shared.device.create_buffer(&info, None) }.map_err(|e| match e {
-            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
-                out_of_memory(&format!("buffer \"{name}\""), size_bytes)
-            }
-            e => GpuError::Vulkan {
-                call: "vkCreateBuffer",
-                result: e,
-            },
-        })?;
+        let raw = unsafe { shared.device.create_buffer(&info, None) }
+            .map_err(|e| creation_error("vkCreateBuffer", &what, size_bytes, e))?;
         // SAFETY: `raw` was just created on this device.
         let requirements = unsafe { shared.device.get_buffer_memory_requirements(raw) };
-        shared
-            .allocations
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let allocation = shared.allocator().allocate(&AllocationCreateDesc {
-            name,
+        let location = residency.location();
+        let allocation = allocate(
+            &shared,
+            (name, &what, size_bytes),
             requirements,
-            location: residency.location(),
-            linear: true,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(e) => {
-                // SAFETY: the buffer is unused and unbound.
-                unsafe { shared.device.destroy_buffer(raw, None) };
-                return Err(match e {
-                    gpu_allocator::AllocationError::OutOfMemory => {
-                        out_of_memory(&format!("buffer \"{name}\""), size_bytes)
-                    }
-                    e => GpuError::Unsupported(format!("allocating buffer \"{name}\": {e}")),
-                });
-            }
-        };
+            location,
+            true,
+        )
+        .inspect_err(|_| {
+            // SAFETY: the buffer is unused and unbound.
+            unsafe { shared.device.destroy_buffer(raw, None) }
+        })?;
         // SAFETY: memory and buffer come from the same device; the offset is aligned by the
         // allocator according to the requirements.
         let bound = unsafe {

@@ -402,9 +402,7 @@ impl<'a> Recorder<'a> {
 
     pub fn copy_buffer_to_image(&mut self, src: &Buffer, dst: &Image) {
         self.sync(&[Resource::buffer(src)], &[Resource::image(dst)]);
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(dst.subresource_layers())
-            .image_extent(dst.vk_extent())];
+        let region = [dst.whole_copy()];
         // SAFETY: recording; the image is in GENERAL layout and the buffer holds every texel.
         unsafe {
             self.device().cmd_copy_buffer_to_image(
@@ -420,9 +418,7 @@ impl<'a> Recorder<'a> {
     /// Copies the whole image into `dst`, tightly packed (row-major x, then y, then z).
     pub fn copy_image_to_buffer(&mut self, src: &Image, dst: &Buffer) {
         self.sync(&[Resource::image(src)], &[Resource::buffer(dst)]);
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(src.subresource_layers())
-            .image_extent(src.vk_extent())];
+        let region = [src.whole_copy()];
         // SAFETY: recording; the image is in GENERAL layout and the buffer fits every texel.
         unsafe {
             self.device().cmd_copy_image_to_buffer(

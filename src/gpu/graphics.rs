@@ -393,17 +393,11 @@ impl<'a> GraphicsPipelineBuilder<'a> {
                 attachment: attachments.len() as u32,
                 layout: general,
             });
-            attachments.push(
-                vk::AttachmentDescription::default()
-                    .format(target.format.vk())
-                    .samples(samples)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-                    .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-                    .initial_layout(general)
-                    .final_layout(general),
-            );
+            attachments.push(stored_attachment(
+                target.format.vk(),
+                samples,
+                vk::AttachmentLoadOp::CLEAR,
+            ));
         }
         let any_resolve = self.colors.iter().any(|c| c.resolve);
         let mut resolve_refs = Vec::new();
@@ -413,17 +407,11 @@ impl<'a> GraphicsPipelineBuilder<'a> {
                     attachment: attachments.len() as u32,
                     layout: general,
                 });
-                attachments.push(
-                    vk::AttachmentDescription::default()
-                        .format(target.format.vk())
-                        .samples(vk::SampleCountFlags::TYPE_1)
-                        .load_op(vk::AttachmentLoadOp::DONT_CARE)
-                        .store_op(vk::AttachmentStoreOp::STORE)
-                        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-                        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-                        .initial_layout(general)
-                        .final_layout(general),
-                );
+                attachments.push(stored_attachment(
+                    target.format.vk(),
+                    vk::SampleCountFlags::TYPE_1,
+                    vk::AttachmentLoadOp::DONT_CARE,
+                ));
             } else {
                 resolve_refs.push(vk::AttachmentReference {
                     attachment: vk::ATTACHMENT_UNUSED,
@@ -441,17 +429,11 @@ impl<'a> GraphicsPipelineBuilder<'a> {
                 attachment: attachments.len() as u32,
                 layout: general,
             };
-            attachments.push(
-                vk::AttachmentDescription::default()
-                    .format(format.vk())
-                    .samples(samples)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
-                    .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
-                    .initial_layout(general)
-                    .final_layout(general),
-            );
+            attachments.push(stored_attachment(
+                format.vk(),
+                samples,
+                vk::AttachmentLoadOp::CLEAR,
+            ));
             reference
         });
         let mut subpass = vk::SubpassDescription::default()
@@ -625,4 +607,22 @@ impl Drop for GraphicsPipeline {
             device.destroy_render_pass(self.render_pass, None);
         }
     }
+}
+
+/// An attachment kept in GENERAL like every image and stored after the pass (no stencil).
+fn stored_attachment(
+    format: vk::Format,
+    samples: vk::SampleCountFlags,
+    load: vk::AttachmentLoadOp,
+) -> vk::AttachmentDescription {
+    let general = vk::ImageLayout::GENERAL;
+    vk::AttachmentDescription::default()
+        .format(format)
+        .samples(samples)
+        .load_op(load)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .stencil_load_op(vk::AttachmentLoadOp::DONT_CARE)
+        .stencil_store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .initial_layout(general)
+        .final_layout(general)
 }

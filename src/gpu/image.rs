@@ -7,10 +7,10 @@
 use std::sync::Arc;
 
 use ash::vk;
-use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use gpu_allocator::vulkan::Allocation;
 use gpu_allocator::MemoryLocation;
 
-use super::buffer::{out_of_memory, Buffer, Residency};
+use super::buffer::{allocate, creation_error, Buffer, Residency};
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 
@@ -94,39 +94,46 @@ impl ImageUsage {
         samples: 1,
     };
 
+    /// Each use this image is put to, with the usage flag and the format features it needs.
+    fn uses(self) -> [(bool, vk::ImageUsageFlags, vk::FormatFeatureFlags); 5] {
+        use vk::{FormatFeatureFlags as F, ImageUsageFlags as U};
+        [
+            (
+                true,
+                U::TRANSFER_SRC | U::TRANSFER_DST,
+                F::TRANSFER_SRC | F::TRANSFER_DST,
+            ),
+            (
+                self.sampled_linear,
+                U::SAMPLED,
+                F::SAMPLED_IMAGE | F::SAMPLED_IMAGE_FILTER_LINEAR,
+            ),
+            (self.storage, U::STORAGE, F::STORAGE_IMAGE),
+            (
+                self.color_attachment,
+                U::COLOR_ATTACHMENT,
+                F::COLOR_ATTACHMENT,
+            ),
+            (
+                self.depth_attachment,
+                U::DEPTH_STENCIL_ATTACHMENT,
+                F::DEPTH_STENCIL_ATTACHMENT,
+            ),
+        ]
+    }
+
     fn flags(self) -> vk::ImageUsageFlags {
-        let mut f = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
-        if self.sampled_linear {
-            f |= vk::ImageUsageFlags::SAMPLED;
-        }
-        if self.storage {
-            f |= vk::ImageUsageFlags::STORAGE;
-        }
-        if self.color_attachment {
-            f |= vk::ImageUsageFlags::COLOR_ATTACHMENT;
-        }
-        if self.depth_attachment {
-            f |= vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
-        }
-        f
+        self.uses()
+            .into_iter()
+            .filter(|u| u.0)
+            .fold(vk::ImageUsageFlags::empty(), |f, u| f | u.1)
     }
 
     fn format_features(self) -> vk::FormatFeatureFlags {
-        let mut f = vk::FormatFeatureFlags::TRANSFER_SRC | vk::FormatFeatureFlags::TRANSFER_DST;
-        if self.sampled_linear {
-            f |= vk::FormatFeatureFlags::SAMPLED_IMAGE
-                | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR;
-        }
-        if self.storage {
-            f |= vk::FormatFeatureFlags::STORAGE_IMAGE;
-        }
-        if self.color_attachment {
-            f |= vk::FormatFeatureFlags::COLOR_ATTACHMENT;
-        }
-        if self.depth_attachment {
-            f |= vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT;
-        }
-        f
+        self.uses()
+            .into_iter()
+            .filter(|u| u.0)
+            .fold(vk::FormatFeatureFlags::empty(), |f, u| f | u.2)
     }
 }
 
@@ -239,41 +246,18 @@ impl Image {
         let bytes = extent.iter().map(|&e| e as u64).product::<u64>()
             * format.bytes_per_texel()
             * u64::from(usage.samples.max(1));
+        let what = format!("image \"{name}\"");
         // SAFETY: valid create info on a live device.
-        let raw = unsafe { shared.device.create_image(&info, None) }.map_err(|e| match e {
-            vk::Result::ERROR_OUT_OF_DEVICE_MEMORY | vk::Result::ERROR_OUT_OF_HOST_MEMORY => {
-                out_of_memory(&format!("image \"{name}\""), bytes)
-            }
-            e => GpuError::Vulkan {
-                call: "vkCreateImage",
-                result: e,
-            },
-        })?;
+        let raw = unsafe { shared.device.create_image(&info, None) }
+            .map_err(|e| creation_error("vkCreateImage", &what, bytes, e))?;
         // SAFETY: `raw` was just created on this device.
         let requirements = unsafe { shared.device.get_image_memory_requirements(raw) };
-        shared
-            .allocations
-            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let allocation = shared.allocator().allocate(&AllocationCreateDesc {
-            name,
-            requirements,
-            location: MemoryLocation::GpuOnly,
-            linear: false,
-            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-        });
-        let allocation = match allocation {
-            Ok(a) => a,
-            Err(e) => {
+        let location = MemoryLocation::GpuOnly;
+        let allocation = allocate(&shared, (name, &what, bytes), requirements, location, false)
+            .inspect_err(|_| {
                 // SAFETY: the image is unused and unbound.
-                unsafe { shared.device.destroy_image(raw, None) };
-                return Err(match e {
-                    gpu_allocator::AllocationError::OutOfMemory => {
-                        out_of_memory(&format!("image \"{name}\""), bytes)
-                    }
-                    e => GpuError::Unsupported(format!("allocating image \"{name}\": {e}")),
-                });
-            }
-        };
+                unsafe { shared.device.destroy_image(raw, None) }
+            })?;
         let mut image = Image {
             shared: shared.clone(),
             raw,
@@ -327,13 +311,20 @@ impl Image {
         }
     }
 
-    pub(crate) fn subresource_layers(&self) -> vk::ImageSubresourceLayers {
+    fn subresource_layers(&self) -> vk::ImageSubresourceLayers {
         vk::ImageSubresourceLayers {
             aspect_mask: self.format.aspect(),
             mip_level: 0,
             base_array_layer: 0,
             layer_count: 1,
         }
+    }
+
+    /// A copy of every texel between this image and a tightly packed buffer.
+    pub(crate) fn whole_copy(&self) -> vk::BufferImageCopy {
+        vk::BufferImageCopy::default()
+            .image_subresource(self.subresource_layers())
+            .image_extent(self.vk_extent())
     }
 
     pub fn raw(&self) -> vk::Image {
