@@ -163,21 +163,7 @@ impl Measurer {
         pupil_mm: f64,
         object_distance_m: Option<f64>,
     ) -> Result<Measurement, EyeError> {
-        let Chief {
-            n,
-            ns,
-            nv,
-            px,
-            py,
-            ep_z,
-            xp_z,
-            launch,
-            chief,
-            image,
-            xp_centre,
-            rs,
-            l_ref,
-        } = chief_ray(
+        let a = chief_ray(
             sys,
             wavelength_nm,
             pupil_mm,
@@ -190,11 +176,9 @@ impl Measurer {
         let mut valid = vec![true; np];
         let mut vignetted = 0;
         for (i, p) in self.pattern.points.iter().enumerate() {
-            let mut ray = launch(p[0], p[1]);
-            let ok = trace_range(sys, &n, &mut ray, 0..ns).is_ok();
-            match (ok, path_to_sphere(&ray, image, rs)) {
-                (true, Some(s)) => w[i] = 1000.0 * (l_ref - ray.opl_mm - nv * s),
-                _ => {
+            match a.wavefront_um(sys, p) {
+                Some(v) => w[i] = v,
+                None => {
                     valid[i] = false;
                     vignetted += 1;
                 }
@@ -213,18 +197,18 @@ impl Measurer {
         // Rim rays for the pupil sizes and the image-side aperture.
         let (mut iris_r, mut xp_r, mut sin_sum, mut rim_n) = (0.0f64, 0.0, 0.0, 0usize);
         for r in &self.rim {
-            let mut ray = launch(r[0], r[1]);
-            if trace_range(sys, &n, &mut ray, 0..sys.stop_index).is_err() {
+            let mut ray = (a.launch)(r[0], r[1]);
+            if trace_range(sys, &a.n, &mut ray, 0..sys.stop_index).is_err() {
                 continue;
             }
             let at_stop = ray.at(ray.to_plane(sys.stop_z_mm));
             iris_r = iris_r.max(at_stop[0].hypot(at_stop[1]));
-            if trace_range(sys, &n, &mut ray, sys.stop_index..ns).is_err() {
+            if trace_range(sys, &a.n, &mut ray, sys.stop_index..a.ns).is_err() {
                 continue;
             }
-            let q = ray.at(ray.to_plane(xp_z));
-            xp_r += (q[0] - xp_centre[0]).hypot(q[1] - xp_centre[1]);
-            let cosang = dot(ray.d, chief.d).clamp(-1.0, 1.0);
+            let q = ray.at(ray.to_plane(a.xp_z));
+            xp_r += (q[0] - a.xp_centre[0]).hypot(q[1] - a.xp_centre[1]);
+            let cosang = dot(ray.d, a.chief.d).clamp(-1.0, 1.0);
             sin_sum += (1.0 - cosang * cosang).sqrt();
             rim_n += 1;
         }
@@ -232,20 +216,20 @@ impl Measurer {
         let sin_angle = sin_sum / rim_n;
         Ok(assemble(
             &c,
-            &px,
-            &py,
+            &a.px,
+            &a.py,
             Extra {
                 wavelength_nm,
                 pupil_mm,
                 object_distance_m,
                 order: self.pattern.order,
-                ep_z,
-                xp_z,
+                ep_z: a.ep_z,
+                xp_z: a.xp_z,
                 iris_d: 2.0 * iris_r,
                 xp_d: 2.0 * xp_r / rim_n,
                 sin_angle,
-                nv,
-                image,
+                nv: a.nv,
+                image: a.image,
                 retina_z: sys.retina_z_mm,
                 stop_z: sys.stop_z_mm,
                 rays: np,
@@ -264,24 +248,12 @@ impl Measurer {
         object_distance_m: Option<f64>,
         out: &mut [f64],
     ) -> Result<(), EyeError> {
-        let Chief {
-            n,
-            ns,
-            nv,
-            launch,
-            image,
-            rs,
-            l_ref,
-            ..
-        } = chief_ray(sys, wavelength_nm, pupil_mm, object_distance_m, "")?;
+        let a = chief_ray(sys, wavelength_nm, pupil_mm, object_distance_m, "")?;
         let np = self.pattern.points.len();
         let mut w = vec![0.0; np];
         for (i, p) in self.pattern.points.iter().enumerate() {
-            let mut ray = launch(p[0], p[1]);
-            trace_range(sys, &n, &mut ray, 0..ns)
-                .ok()
-                .and_then(|_| path_to_sphere(&ray, image, rs))
-                .map(|s| w[i] = 1000.0 * (l_ref - ray.opl_mm - nv * s))
+            w[i] = a
+                .wavefront_um(sys, p)
                 .ok_or_else(|| EyeError::Invalid("ray vignetted".into()))?;
         }
         self.pattern.fit(&w, out);
@@ -308,6 +280,17 @@ struct Chief<L> {
     /// path to it.
     rs: f64,
     l_ref: f64,
+}
+
+impl<L: Fn(f64, f64) -> Ray> Chief<L> {
+    /// The wavefront (µm, against the reference sphere) of the ray through pupil point `p`;
+    /// none where it is vignetted.
+    fn wavefront_um(&self, sys: &OpticalSystem, p: &[f64; 2]) -> Option<f64> {
+        let mut ray = (self.launch)(p[0], p[1]);
+        trace_range(sys, &self.n, &mut ray, 0..self.ns).ok()?;
+        let s = path_to_sphere(&ray, self.image, self.rs)?;
+        Some(1000.0 * (self.l_ref - ray.opl_mm - self.nv * s))
+    }
 }
 
 /// The inputs checked and the chief ray traced; `vignetted` ends the error where it is
