@@ -11,12 +11,10 @@ use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
 
-use crate::psf::axes::Screen;
 use crate::psf::cache::CacheOutcome;
-use crate::render::frame::{dioptre_range, scene_needs, EyeState, FrameRenderer, Method};
+use crate::render::frame::{EyeState, FrameRenderer, HostFrame, Method};
 pub use crate::render::frame_plan::PupilModel;
-use crate::render::frame_plan::{self, FocusAsked, FrameView, PupilAsked, PupilFallback, SceneEye};
-use crate::render::splat::FrameInput;
+use crate::render::frame_plan::{self, FocusAsked, PupilAsked, PupilFallback, SceneEye};
 use crate::render::Rasterizer;
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -190,35 +188,18 @@ fn render_frame(
     let max_radius = kernels.grid.max_radius_px;
     let field = kernels.field.as_ref().map(|f| f.plan.clone());
     let mut renderer = FrameRenderer::new(ctx, eye, kernels, options.settings.clone(), splat);
-    let hidden: Vec<crate::render::splat::HiddenLayer<'_>> = input
-        .hidden
-        .iter()
-        .map(|(color, depth_m)| crate::render::splat::HiddenLayer { color, depth_m })
-        .collect();
-    let frame_input = FrameInput {
-        width: input.width,
-        height: input.height,
-        color: &input.color,
-        depth_m: &input.depth_m,
-        fov_y_deg: input.fov_y_deg,
-        hidden_layers: if args.method == Method::Splat {
-            &hidden
-        } else {
-            &[]
-        },
-    };
     let frame = match &mut input.raster {
         // the frame stays on the GPU: drawn again in splat's submission, not uploaded
         Some((rasterizer, scene, layers)) if args.method == Method::Splat => {
             let scene_state = scene.at_time(args.time);
-            let size = (input.width, input.height);
+            let size = (input.frame.width, input.frame.height);
             let gap_d = args.splat.blend.settings().group_tolerance_d;
             let mut recorded = rasterizer
                 .scene_frame(ctx, &scene_state, size)
                 .peeled(*layers, gap_d);
             renderer.render_recorded(&mut recorded, state)?
         }
-        _ => renderer.render(&frame_input, state, args.method)?,
+        _ => input.frame.render(&mut renderer, state, args.method)?,
     };
 
     let info = super::render_output::KernelInfo {
@@ -322,16 +303,7 @@ fn parse_pixel(text: &str) -> std::result::Result<(u32, u32), String> {
 
 /// A frame to render, from a scene or from files.
 pub(super) struct Input {
-    pub(super) width: u32,
-    pub(super) height: u32,
-    pub(super) color: Vec<[f32; 4]>,
-    pub(super) depth_m: Vec<f32>,
-    pub(super) fov_y_deg: f64,
-    pub(super) focus_m: Option<f64>,
-    pub(super) pupil_mm: Option<f64>,
-    pub(super) luminance_cdm2: Option<f64>,
-    /// Hidden depth layers (colour, depth), nearest first.
-    pub(super) hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
+    pub(super) frame: HostFrame,
     pub(super) label: String,
     /// Where the depth came from, and what the depth policy found (file input).
     pub(super) depth_source: Option<String>,
@@ -375,22 +347,22 @@ fn load_input(
             );
         }
         return Ok(Input {
-            width: file.color.width,
-            height: file.color.height,
-            color: file.color.pixels,
-            depth_m: file.depth_m,
-            fov_y_deg,
-            focus_m: None,
-            pupil_mm: None,
-            luminance_cdm2: None,
+            frame: HostFrame {
+                width: file.color.width,
+                height: file.color.height,
+                color: file.color.pixels,
+                depth_m: file.depth_m,
+                fov_y_deg,
+                hidden: file
+                    .hidden_layers
+                    .into_iter()
+                    .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
+                    .collect(),
+                scene: SceneEye::default(),
+            },
             label: file.color_source,
             depth_source: Some(file.depth_source),
             depth_report: Some(file.depth_report),
-            hidden: file
-                .hidden_layers
-                .into_iter()
-                .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
-                .collect(),
             warnings,
             raster: None,
         });
@@ -430,20 +402,19 @@ fn load_input(
         &mut depth_m,
         &format!("scene {name}"),
     ));
-    let (fov_y_deg, focus_m) = (state.camera.fov_y_deg, state.focus_m);
-    let (pupil_mm, luminance_cdm2) = (state.pupil_mm, state.luminance_cd_m2);
-    Ok(Input {
+    let frame = HostFrame {
         width,
         height,
         color: frame.color,
         depth_m,
-        fov_y_deg,
-        focus_m: Some(focus_m),
-        pupil_mm,
-        luminance_cdm2,
+        fov_y_deg: state.camera.fov_y_deg,
+        hidden: Vec::new(),
+        scene: SceneEye::of(&state),
+    };
+    Ok(Input {
+        frame,
         label: format!("scene {name}"),
         raster: Some((rasterizer, scene, k)),
-        hidden: Vec::new(),
         depth_source: None,
         depth_report: None,
         warnings,
@@ -487,26 +458,6 @@ fn pupil_asked(args: &RenderArgs) -> PupilAsked<'static> {
     }
 }
 
-impl Input {
-    fn view(&self) -> FrameView<'_> {
-        FrameView {
-            width: self.width,
-            height: self.height,
-            fov_y_deg: self.fov_y_deg,
-            color: &self.color,
-            depth_m: &self.depth_m,
-        }
-    }
-
-    fn scene_eye(&self) -> SceneEye {
-        SceneEye {
-            focus_m: self.focus_m,
-            pupil_mm: self.pupil_mm,
-            luminance_cdm2: self.luminance_cdm2,
-        }
-    }
-}
-
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     let splat = check_args(args)?;
     let (eye, physiology) = args.correction.apply(
@@ -518,10 +469,8 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     for w in &input.warnings {
         eprintln!("warning: {w}");
     }
-    let (focus_d, focus_from) =
-        frame_plan::focus_d(focus_asked(args)?, &input.scene_eye(), &input.view())?;
-    let (pupil_mm, pupil_source) =
-        frame_plan::pupil_mm(&pupil_asked(args), &input.scene_eye(), &input.view())?;
+    let (focus_d, focus_from) = input.frame.focus_d(focus_asked(args)?)?;
+    let (pupil_mm, pupil_source) = input.frame.pupil_mm(&pupil_asked(args))?;
     let mut options = args.cache.kernel_options();
     if args.splat.off_axis {
         if matches!(args.method, Method::Slices | Method::Views) {
@@ -530,7 +479,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
                  on-axis PSF)",
             ));
         }
-        options.field_width_px = Some(input.width);
+        options.field_width_px = Some(input.frame.width);
     }
     let focus = crate::render::focus::effective_focus(
         &eye,
@@ -540,26 +489,13 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         &focus_from,
     )?;
     let state = EyeState { focus_d, pupil_mm };
-    let screen = Screen {
-        fov_y_deg: input.fov_y_deg,
-        height_px: input.height,
-    };
-    let needs = scene_needs(
-        &[dioptre_range(
-            &input.depth_m,
-            input.width,
-            input.height,
-            input.fov_y_deg,
-        )],
-        &[state],
-        screen,
-    );
+    let needs = input.frame.needs(state);
     if args.method == Method::Views {
         let scene = Scene::load(args.scene.as_deref().unwrap_or("primitives"))?;
         let frame = super::occlusion::render_views(
             &ctx,
             &scene.at_time(args.time),
-            (input.width, input.height),
+            (input.frame.width, input.frame.height),
             &eye,
             (pupil_mm, focus_d),
             args.views,

@@ -103,9 +103,9 @@ pub(super) fn finish(
         output: args.output.display().to_string(),
         input: input.label.clone(),
         eye: args.eye.clone(),
-        width: input.width,
-        height: input.height,
-        fov_y_deg: input.fov_y_deg,
+        width: input.frame.width,
+        height: input.frame.height,
+        fov_y_deg: input.frame.fov_y_deg,
         depth: input.depth_source.clone(),
         depth_report: input.depth_report.clone(),
         focus_d,
@@ -148,7 +148,7 @@ fn write_image(
     frame: &crate::render::frame::RenderedFrame,
     output_ext: Option<&str>,
 ) -> Result<()> {
-    let image = ImageRgba::new(input.width, input.height, frame.color.clone());
+    let image = ImageRgba::new(input.frame.width, input.frame.height, frame.color.clone());
     if output_ext == Some("exr") {
         return image_io::write_exr_rgba(&args.output, &image);
     }
@@ -159,9 +159,9 @@ fn write_image(
     // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
     let exposure_ev = args.exposure.unwrap_or_else(|| {
         Tonemap::auto_exposure_ev(&ImageRgba::new(
-            input.width,
-            input.height,
-            input.color.clone(),
+            input.frame.width,
+            input.frame.height,
+            input.frame.color.clone(),
         ))
     });
     image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })
@@ -209,8 +209,8 @@ fn print_summary(
     println!(
         "wrote {} ({}×{}, {}, eye {} focused at {focus}, pupil {:.2} mm from {}; {} {:.2} s; kernels {})",
         summary.output,
-        input.width,
-        input.height,
+        input.frame.width,
+        input.frame.height,
         input.label,
         args.eye,
         summary.pupil_mm,

@@ -3,10 +3,9 @@
 
 use crate::eye::age::HofstetterLine;
 use crate::eye::Eye;
-use crate::render::frame::Method;
+use crate::render::frame::{HostFrame, Method};
 use crate::render::frame_plan::{
-    self, Correction, FocusAsked, FrameView, Physiology, PupilAsked, PupilFallback, PupilModel,
-    SceneEye,
+    self, Correction, FocusAsked, Physiology, PupilAsked, PupilFallback, PupilModel,
 };
 use crate::{Error, Result};
 
@@ -23,21 +22,6 @@ pub(super) struct Options {
     pub(super) method: Method,
     pub(super) layers: u32,
     pub(super) off_axis: bool,
-}
-
-/// A frame on the host: what the methods read, and what focus and pupil are resolved from.
-#[derive(Clone)]
-pub(super) struct HostFrame {
-    pub(super) width: u32,
-    pub(super) height: u32,
-    pub(super) fov_y_deg: f64,
-    pub(super) color: Vec<[f32; 4]>,
-    pub(super) depth_m: Vec<f32>,
-    pub(super) hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
-    /// A scene's own focus (m; ≤ 0 or ∞ = infinity), pupil and luminance.
-    pub(super) scene_focus_m: Option<f64>,
-    pub(super) scene_pupil_mm: Option<f64>,
-    pub(super) scene_luminance_cdm2: Option<f64>,
 }
 
 fn parse_method(name: &str) -> Result<Method> {
@@ -121,26 +105,6 @@ pub(super) fn options(
     })
 }
 
-impl HostFrame {
-    fn view(&self) -> FrameView<'_> {
-        FrameView {
-            width: self.width,
-            height: self.height,
-            fov_y_deg: self.fov_y_deg,
-            color: &self.color,
-            depth_m: &self.depth_m,
-        }
-    }
-
-    fn scene_eye(&self) -> SceneEye {
-        SceneEye {
-            focus_m: self.scene_focus_m,
-            pupil_mm: self.scene_pupil_mm,
-            luminance_cdm2: self.scene_luminance_cdm2,
-        }
-    }
-}
-
 /// The focus vergence and the words naming its source, as `ocular render` decides (a focus
 /// nearer than ocular renders is refused).
 pub(super) fn focus_dioptres(o: &Options, f: &HostFrame) -> Result<(f64, String)> {
@@ -149,7 +113,7 @@ pub(super) fn focus_dioptres(o: &Options, f: &HostFrame) -> Result<(f64, String)
         .map(FocusAsked::DistanceM)
         .or(o.focus_d.map(FocusAsked::Dioptres))
         .or(o.focus_at.map(|(x, y)| FocusAsked::AtPixel(x, y)));
-    frame_plan::focus_d(asked, &f.scene_eye(), &f.view())
+    f.focus_d(asked)
 }
 
 /// The pupil as `ocular render` picks it: given, else Watson–Yellott at the luminance given,
@@ -162,7 +126,7 @@ pub(super) fn pupil_diameter(o: &Options, f: &HostFrame) -> Result<(f64, String)
         age_years: o.age,
         fallback: PupilFallback::Luminance,
     };
-    frame_plan::pupil_mm(&asked, &f.scene_eye(), &f.view())
+    f.pupil_mm(&asked)
 }
 
 /// The eye as the CLI renders it: with the age's amplitude of accommodation unless its file

@@ -13,17 +13,13 @@ use pyo3::types::PyDict;
 
 use super::arrays::{color_layers, depth_layers, rgb_out};
 use super::eye::PyEye;
-use super::frame_options::{
-    focus_dioptres, options, physiology, pupil_diameter, HostFrame, Options,
-};
+use super::frame_options::{focus_dioptres, options, physiology, pupil_diameter, Options};
 use super::guarded;
 use crate::eye::Eye;
 use crate::gpu::{Context, ContextOptions};
-use crate::psf::axes::Screen;
-use crate::render::frame::{
-    dioptre_range, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
-};
-use crate::render::splat::{FrameInput, HiddenLayer, SplatSettings};
+use crate::render::frame::{EyeState, FrameRenderer, HostFrame, KernelOptions, Method};
+use crate::render::frame_plan::SceneEye;
+use crate::render::splat::SplatSettings;
 use crate::render::Rasterizer;
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -124,12 +120,7 @@ impl PyRenderer {
             field_width_px: options.field_width_px,
             splat: SplatSettings::default(),
         };
-        let range = dioptre_range(&frame.depth_m, frame.width, frame.height, frame.fov_y_deg);
-        let screen = Screen {
-            fov_y_deg: frame.fov_y_deg,
-            height_px: frame.height,
-        };
-        let needs = scene_needs(&[range], &[state], screen);
+        let needs = frame.needs(state);
         let planned = crate::psf::plan::plan_for_scene(&needs, &options.reference_axes)
             .map_err(Error::input)?;
         let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
@@ -179,22 +170,7 @@ impl PyRenderer {
                     .peeled(o.layers, gap_d);
                 renderer.render_recorded(&mut recorded, state)?
             }
-            _ => {
-                let hidden: Vec<HiddenLayer<'_>> = frame
-                    .hidden
-                    .iter()
-                    .map(|(color, depth_m)| HiddenLayer { color, depth_m })
-                    .collect();
-                let input = FrameInput {
-                    width: frame.width,
-                    height: frame.height,
-                    color: &frame.color,
-                    depth_m: &frame.depth_m,
-                    fov_y_deg: frame.fov_y_deg,
-                    hidden_layers: &hidden,
-                };
-                renderer.render(&input, state, o.method)?
-            }
+            _ => frame.render(renderer, state, o.method)?,
         };
         inner.counters.frames += 1;
         inner.last = Some(FrameReport {
@@ -276,9 +252,7 @@ impl PyRenderer {
             color: drawn.color,
             depth_m,
             hidden: Vec::new(),
-            scene_focus_m: Some(state.focus_m),
-            scene_pupil_mm: state.pupil_mm,
-            scene_luminance_cdm2: state.luminance_cd_m2,
+            scene: SceneEye::of(&state),
         };
         inner.host = Some((host_key, frame.clone(), warnings.clone()));
         Ok((frame, warnings))
@@ -392,9 +366,7 @@ impl PyRenderer {
             color: first_color,
             depth_m: first_depth,
             hidden: pairs.take(o.layers as usize - 1).collect(),
-            scene_focus_m: None,
-            scene_pupil_mm: None,
-            scene_luminance_cdm2: None,
+            scene: SceneEye::default(),
         };
         let eye = eye.eye.clone();
         let pixels = guarded(py, || self.render_frame(&eye, &o, &frame, None))?;

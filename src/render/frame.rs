@@ -16,8 +16,9 @@ use crate::psf::grid::{compute_grid, GridReport, Stage};
 use crate::psf::kernels::KernelGrid;
 use crate::psf::plan::{plan_for_scene, Plan, SceneNeeds};
 use crate::render::blend::BlendSettings;
+use crate::render::frame_plan::{self, FocusAsked, FrameView, PupilAsked, SceneEye};
 use crate::render::splat::{
-    FrameInput, RecordedInput, SplatSettings, SplatStats, Splatter, ViewState,
+    FrameInput, HiddenLayer, RecordedInput, SplatSettings, SplatStats, Splatter, ViewState,
 };
 use crate::render::{reference, slices};
 use crate::{Error, Result};
@@ -157,6 +158,80 @@ pub fn scene_needs(ranges: &[(f64, f64)], states: &[EyeState], screen: Screen) -
         focus_d: focus,
         pupils_mm: pupils,
         screen,
+    }
+}
+
+/// A frame on the host, from a scene or from files: what the methods read, and what focus and
+/// pupil are resolved from (`ocular render` and the Python renderer alike).
+#[derive(Clone)]
+pub struct HostFrame {
+    pub width: u32,
+    pub height: u32,
+    pub fov_y_deg: f64,
+    pub color: Vec<[f32; 4]>,
+    pub depth_m: Vec<f32>,
+    /// Hidden depth layers (colour, depth), nearest first.
+    pub hidden: Vec<(Vec<[f32; 4]>, Vec<f32>)>,
+    /// A scene's own focus, pupil and luminance (none for files).
+    pub scene: SceneEye,
+}
+
+impl HostFrame {
+    pub fn view(&self) -> FrameView<'_> {
+        FrameView {
+            width: self.width,
+            height: self.height,
+            fov_y_deg: self.fov_y_deg,
+            color: &self.color,
+            depth_m: &self.depth_m,
+        }
+    }
+
+    /// The focus vergence and the words naming its source (see [`frame_plan::focus_d`]).
+    pub fn focus_d(&self, asked: Option<FocusAsked>) -> Result<(f64, String)> {
+        frame_plan::focus_d(asked, &self.scene, &self.view())
+    }
+
+    /// The pupil diameter and the words naming its source (see [`frame_plan::pupil_mm`]).
+    pub fn pupil_mm(&self, asked: &PupilAsked<'_>) -> Result<(f64, String)> {
+        frame_plan::pupil_mm(asked, &self.scene, &self.view())
+    }
+
+    /// The kernels this frame needs seen in eye state `state`.
+    pub fn needs(&self, state: EyeState) -> SceneNeeds {
+        let range = dioptre_range(&self.depth_m, self.width, self.height, self.fov_y_deg);
+        let screen = Screen {
+            fov_y_deg: self.fov_y_deg,
+            height_px: self.height,
+        };
+        scene_needs(&[range], &[state], screen)
+    }
+
+    /// Renders this frame through `renderer` with `method`; its hidden layers go to splat
+    /// only (the other methods see the visible layer).
+    pub fn render(
+        &self,
+        renderer: &mut FrameRenderer,
+        state: EyeState,
+        method: Method,
+    ) -> Result<RenderedFrame> {
+        let hidden: Vec<HiddenLayer<'_>> = match method {
+            Method::Splat => self
+                .hidden
+                .iter()
+                .map(|(color, depth_m)| HiddenLayer { color, depth_m })
+                .collect(),
+            _ => Vec::new(),
+        };
+        let input = FrameInput {
+            width: self.width,
+            height: self.height,
+            color: &self.color,
+            depth_m: &self.depth_m,
+            fov_y_deg: self.fov_y_deg,
+            hidden_layers: &hidden,
+        };
+        renderer.render(&input, state, method)
     }
 }
 
