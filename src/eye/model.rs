@@ -332,20 +332,16 @@ impl Eye {
         }
         let l = &self.lens;
         let tilt = [l.tilt_deg[0].to_radians(), l.tilt_deg[1].to_radians()];
-        let lens_a = Surface::conic(
-            z_lens,
-            g.anterior_radius_mm,
-            l.anterior_conic,
-            g.semi_diameter_mm,
-        )
-        .with_placement(l.decentration_mm, tilt, z_eq);
-        let lens_p = Surface::conic(
-            z_back,
-            g.posterior_radius_mm,
-            l.posterior_conic,
-            g.semi_diameter_mm,
-        )
-        .with_placement(l.decentration_mm, tilt, z_eq);
+        // Both lens surfaces share the lens's semi-diameter and placement.
+        let lens_surface = |z: f64, radius_mm: f64, conic: f64| {
+            Surface::conic(z, radius_mm, conic, g.semi_diameter_mm).with_placement(
+                l.decentration_mm,
+                tilt,
+                z_eq,
+            )
+        };
+        let lens_a = lens_surface(z_lens, g.anterior_radius_mm, l.anterior_conic);
+        let lens_p = lens_surface(z_back, g.posterior_radius_mm, l.posterior_conic);
         if let Some(a) = self.accommodation_max_d {
             if !(a.is_finite() && (0.0..=super::age::MAX_AMPLITUDE_D).contains(&a)) {
                 return Err(EyeError::Invalid(format!(

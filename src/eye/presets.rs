@@ -39,6 +39,29 @@ fn cornea(ra: f64, ka: f64, rp: f64, kp: f64, t: f64) -> Cornea {
     }
 }
 
+/// A schematic eye: a centred lens of [diameter mm, volume mm³, anterior conic, posterior
+/// conic], the default retina, and no correction, IOL or amplitude of its own.
+fn schematic(axial_length_mm: f64, cornea: Cornea, aqueous_depth_mm: f64, lens: [f64; 4]) -> Eye {
+    let [diameter_mm, volume_mm3, anterior_conic, posterior_conic] = lens;
+    Eye {
+        axial_length_mm,
+        cornea,
+        aqueous_depth_mm,
+        lens: Lens {
+            diameter_mm,
+            volume_mm3,
+            anterior_conic,
+            posterior_conic,
+            decentration_mm: [0.0; 2],
+            tilt_deg: [0.0; 2],
+        },
+        accommodation_max_d: None,
+        correction: None,
+        iol: None,
+        retina: Retina::default(),
+    }
+}
+
 impl Eye {
     /// Navarro's relaxed eye (A = 0) expressed in the parametric form; its lens diameter and
     /// volume are those at which Navarro's two lens surfaces meet.
@@ -46,26 +69,15 @@ impl Eye {
         let (d, v, _) =
             diameter_volume_from_radii(10.2, -6.0, -3.1316, -1.0, NAVARRO_LENS_THICKNESS_MM)
                 .expect("Navarro's lens surfaces meet");
-        Eye {
-            axial_length_mm: NAVARRO_CORNEA_THICKNESS_MM
+        schematic(
+            NAVARRO_CORNEA_THICKNESS_MM
                 + NAVARRO_AQUEOUS_MM
                 + NAVARRO_LENS_THICKNESS_MM
                 + NAVARRO_VITREOUS_MM,
-            cornea: cornea(7.72, -0.26, 6.5, 0.0, NAVARRO_CORNEA_THICKNESS_MM),
-            aqueous_depth_mm: NAVARRO_AQUEOUS_MM,
-            lens: Lens {
-                diameter_mm: d,
-                volume_mm3: v,
-                anterior_conic: -3.1316,
-                posterior_conic: -1.0,
-                decentration_mm: [0.0; 2],
-                tilt_deg: [0.0; 2],
-            },
-            accommodation_max_d: None,
-            correction: None,
-            iol: None,
-            retina: Retina::default(),
-        }
+            cornea(7.72, -0.26, 6.5, 0.0, NAVARRO_CORNEA_THICKNESS_MM),
+            NAVARRO_AQUEOUS_MM,
+            [d, v, -3.1316, -1.0],
+        )
     }
 
     /// The wide-angle schematic eye of Escudero-Sanz & Navarro (1999): Navarro's relaxed
@@ -88,23 +100,12 @@ impl Eye {
     /// −4.0) has a posterior vertex radius of only −1.88 mm, so this eye is about 84 D and
     /// strongly myopic (≈ −11.6 D at 4 mm): a test of extremes, not a typical eye.
     pub fn population_mean() -> Eye {
-        Eye {
-            axial_length_mm: 23.82,
-            cornea: cornea(7.81, -0.29, 6.44, -0.34, 0.55),
-            aqueous_depth_mm: 2.90,
-            lens: Lens {
-                diameter_mm: 11.1,
-                volume_mm3: 160.1,
-                anterior_conic: -4.4,
-                posterior_conic: -4.0,
-                decentration_mm: [0.0; 2],
-                tilt_deg: [0.0; 2],
-            },
-            accommodation_max_d: None,
-            correction: None,
-            iol: None,
-            retina: Retina::default(),
-        }
+        schematic(
+            23.82,
+            cornea(7.81, -0.29, 6.44, -0.34, 0.55),
+            2.90,
+            [11.1, 160.1, -4.4, -4.0],
+        )
     }
 }
 
