@@ -182,6 +182,17 @@ fn check_pupil(p: f64) -> Result<()> {
         .map_err(Error::input)
 }
 
+/// The eye `spec` names (a preset or a file), with the pupil and wavelength it is shown,
+/// measured or drawn at checked first (show, measure, draw).
+fn resolve_at(spec: &str, pupil_mm: f64, wavelength_nm: f64) -> Result<eye_file::EyeFile> {
+    let f = eye_file::resolve(spec)?;
+    check_pupil(pupil_mm)?;
+    crate::limits::WAVELENGTH_NM
+        .check("--wavelength-nm", wavelength_nm)
+        .map_err(Error::input)?;
+    Ok(f)
+}
+
 /// What `eye estimate` fits: a wavefront as given, or a prescription, whose wavefront depends
 /// on the fitted eye (see [`RxTarget`]).
 enum Target {
@@ -426,11 +437,7 @@ fn write_outputs(a: &EstimateArgs, est: &Estimate, command: &str, outputs: &Outp
 }
 
 fn run_show(a: &ShowArgs) -> Result<()> {
-    let f = eye_file::resolve(&a.eye)?;
-    check_pupil(a.pupil_mm)?;
-    crate::limits::WAVELENGTH_NM
-        .check("--wavelength-nm", a.wavelength_nm)
-        .map_err(Error::input)?;
+    let f = resolve_at(&a.eye, a.pupil_mm, a.wavelength_nm)?;
     let text = eye::show::describe(&f.eye, a.wavelength_nm, a.pupil_mm)?;
     print!("{text}");
     if let Some(r) = &f.estimate {
@@ -484,11 +491,7 @@ pub fn parse_field_deg(s: &str) -> Result<[f64; 2]> {
 
 fn run_measure(a: &MeasureArgs) -> Result<()> {
     let field = a.field_deg.as_deref().map(parse_field_deg).transpose()?;
-    let f = eye_file::resolve(&a.eye)?;
-    check_pupil(a.pupil_mm)?;
-    crate::limits::WAVELENGTH_NM
-        .check("--wavelength-nm", a.wavelength_nm)
-        .map_err(Error::input)?;
+    let f = resolve_at(&a.eye, a.pupil_mm, a.wavelength_nm)?;
     if !(1..=10).contains(&a.order) {
         return Err(Error::input(format!(
             "--order {} is not allowed; need 1 to 10",
@@ -596,11 +599,7 @@ fn run_measure(a: &MeasureArgs) -> Result<()> {
 }
 
 fn run_draw(a: &DrawArgs) -> Result<()> {
-    let f = eye_file::resolve(&a.eye)?;
-    check_pupil(a.pupil_mm)?;
-    crate::limits::WAVELENGTH_NM
-        .check("--wavelength-nm", a.wavelength_nm)
-        .map_err(Error::input)?;
+    let f = resolve_at(&a.eye, a.pupil_mm, a.wavelength_nm)?;
     let ext = a
         .output
         .extension()

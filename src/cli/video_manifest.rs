@@ -59,6 +59,11 @@ fn shown<T: std::fmt::Debug>(v: &Option<T>) -> String {
         .map_or("none".to_string(), |v| format!("{v:?}").replace('"', ""))
 }
 
+/// "`option` `old` there, `new` here".
+fn there_here(option: &str, old: impl std::fmt::Display, new: impl std::fmt::Display) -> String {
+    format!("{option} {old} there, {new} here")
+}
+
 /// One line per field that differs, naming the option that sets it.
 pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
     let mut out = Vec::new();
@@ -84,7 +89,7 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
                 &new.scene_sha256[..12]
             )
         } else {
-            format!("--scene {} there, {} here", old.scene, new.scene)
+            there_here("--scene", &old.scene, &new.scene)
         },
     );
     for (option, (a, ah), (b, bh)) in [
@@ -104,11 +109,7 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
             if a == b {
                 format!("{option} {}: the eye's content changed", shown(&b.cloned()))
             } else {
-                format!(
-                    "{option} {} there, {} here",
-                    shown(&a.cloned()),
-                    shown(&b.cloned())
-                )
+                there_here(option, shown(&a.cloned()), shown(&b.cloned()))
             },
         );
     }
@@ -119,10 +120,7 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
             old.size[0], old.size[1], new.size[0], new.size[1]
         ),
     );
-    field(
-        old.fps != new.fps,
-        format!("--fps {} there, {} here", old.fps, new.fps),
-    );
+    field(old.fps != new.fps, there_here("--fps", old.fps, new.fps));
     field(
         old.frame_count != new.frame_count,
         format!(
@@ -132,39 +130,31 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
     );
     field(
         old.format != new.format,
-        format!("--format {} there, {} here", old.format, new.format),
+        there_here("--format", &old.format, &new.format),
     );
     field(
         old.focus_sweep_m != new.focus_sweep_m,
-        format!(
-            "--focus-sweep {} there, {} here",
+        there_here(
+            "--focus-sweep",
             shown(&old.focus_sweep_m),
-            shown(&new.focus_sweep_m)
+            shown(&new.focus_sweep_m),
         ),
     );
     field(
         old.pupil_mm != new.pupil_mm,
-        format!(
-            "--pupil-mm {} there, {} here",
-            shown(&old.pupil_mm),
-            shown(&new.pupil_mm)
-        ),
+        there_here("--pupil-mm", shown(&old.pupil_mm), shown(&new.pupil_mm)),
     );
     field(
         old.exposure_ev != new.exposure_ev,
-        format!(
-            "--exposure {} there, {} here",
+        there_here(
+            "--exposure",
             shown(&old.exposure_ev),
-            shown(&new.exposure_ev)
+            shown(&new.exposure_ev),
         ),
     );
     field(
         old.layers != new.layers,
-        format!(
-            "--layers {} there, {} here",
-            old.layers.unwrap_or(1),
-            new.layers.unwrap_or(1)
-        ),
+        there_here("--layers", old.layers.unwrap_or(1), new.layers.unwrap_or(1)),
     );
     field(
         old.settings_sha256 != new.settings_sha256,
