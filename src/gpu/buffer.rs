@@ -6,6 +6,7 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
+use super::commands::Recorder;
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 
@@ -268,33 +269,59 @@ impl Buffer {
         if bytes.is_empty() {
             return Ok(());
         }
-        let mut staging = Buffer::new(
-            ctx,
-            &format!("{} staging", self.name),
-            bytes.len() as u64,
-            Residency::Upload,
-        )?;
+        ctx.upload_staged(&self.name, bytes, |rec, staging| {
+            rec.copy_buffer(staging, self, bytes.len() as u64)
+        })
+    }
+
+    /// Reads the whole buffer back as `T`s (via a read-back buffer).
+    pub fn read<T: bytemuck::Pod>(&self, ctx: &Context) -> GpuResult<Vec<T>> {
+        let readback = ctx.read_staged(&self.name, self.size_bytes, |rec, readback| {
+            rec.copy_buffer(self, readback, self.size_bytes)
+        })?;
+        readback.read_mapped_all()
+    }
+}
+
+impl Context {
+    /// Copies `bytes` to a resource named `name` through a new staging buffer, which `copy`
+    /// reads in one submission.
+    pub(crate) fn upload_staged(
+        &self,
+        name: &str,
+        bytes: &[u8],
+        copy: impl FnOnce(&mut Recorder<'_>, &Buffer),
+    ) -> GpuResult<()> {
+        let len = bytes.len() as u64;
+        let mut staging = Buffer::new(self, &format!("{name} staging"), len, Residency::Upload)?;
+        // Buffers are at least 16 bytes: a tiny upload fills only the start of its staging.
         staging.write_mapped(0, bytes)?;
-        ctx.submit(|rec| {
-            rec.copy_buffer(&staging, self, bytes.len() as u64);
+        self.submit(|rec| {
+            copy(rec, &staging);
             Ok(())
         })?;
         Ok(())
     }
 
-    /// Reads the whole buffer back as `T`s (via a read-back buffer).
-    pub fn read<T: bytemuck::Pod>(&self, ctx: &Context) -> GpuResult<Vec<T>> {
+    /// A new read-back buffer of `bytes` that `copy` fills from a resource named `name`, in one
+    /// submission.
+    pub(crate) fn read_staged(
+        &self,
+        name: &str,
+        bytes: u64,
+        copy: impl FnOnce(&mut Recorder<'_>, &Buffer),
+    ) -> GpuResult<Buffer> {
         let readback = Buffer::new(
-            ctx,
-            &format!("{} readback", self.name),
-            self.size_bytes,
+            self,
+            &format!("{name} readback"),
+            bytes,
             Residency::Readback,
         )?;
-        ctx.submit(|rec| {
-            rec.copy_buffer(self, &readback, self.size_bytes);
+        self.submit(|rec| {
+            copy(rec, &readback);
             Ok(())
         })?;
-        readback.read_mapped_all()
+        Ok(readback)
     }
 }
 

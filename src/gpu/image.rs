@@ -10,7 +10,7 @@ use ash::vk;
 use gpu_allocator::vulkan::Allocation;
 use gpu_allocator::MemoryLocation;
 
-use super::buffer::{allocate, creation_error, Buffer, Residency};
+use super::buffer::{allocate, creation_error};
 use super::context::{Context, DeviceShared};
 use super::error::{GpuError, GpuResult, VkContext};
 
@@ -377,32 +377,15 @@ impl Image {
                 ),
             });
         }
-        let mut staging = Buffer::new(
-            ctx,
-            &format!("{} staging", self.name),
-            bytes.len() as u64,
-            Residency::Upload,
-        )?;
-        // Buffers are at least 16 bytes: a tiny image fills only the start of its staging.
-        staging.write_mapped(0, bytes)?;
-        ctx.submit(|rec| {
-            rec.copy_buffer_to_image(&staging, self);
-            Ok(())
-        })?;
-        Ok(())
+        ctx.upload_staged(&self.name, bytes, |rec, staging| {
+            rec.copy_buffer_to_image(staging, self)
+        })
     }
 
     /// Reads the whole image back, tightly packed in the layout `upload` takes.
     pub fn read<T: bytemuck::Pod>(&self, ctx: &Context) -> GpuResult<Vec<T>> {
-        let readback = Buffer::new(
-            ctx,
-            &format!("{} readback", self.name),
-            self.size_bytes(),
-            Residency::Readback,
-        )?;
-        ctx.submit(|rec| {
-            rec.copy_image_to_buffer(self, &readback);
-            Ok(())
+        let readback = ctx.read_staged(&self.name, self.size_bytes(), |rec, readback| {
+            rec.copy_image_to_buffer(self, readback)
         })?;
         readback.read_mapped(0, self.size_bytes() as usize / std::mem::size_of::<T>())
     }
