@@ -278,36 +278,28 @@ impl Rasterizer {
             depth_attachment: depth,
             samples,
         };
-        let color_ms = Image::new_2d(
-            ctx,
+        // every target is a width × height image
+        let target = |name: &str, format: TexelFormat, usage: ImageUsage| {
+            Image::new_2d(ctx, name, width, height, format, usage)
+        };
+        let color_ms = target(
             "raster colour (MSAA)",
-            width,
-            height,
             TexelFormat::Rgba32Float,
             attachment(false, false, MSAA_SAMPLES),
         )?;
-        let view_depth_ms = Image::new_2d(
-            ctx,
+        let view_depth_ms = target(
             "raster view depth (MSAA)",
-            width,
-            height,
             TexelFormat::R32Float,
             attachment(false, true, MSAA_SAMPLES),
         )?;
-        let depth_ms = Image::new_2d(
-            ctx,
+        let depth_ms = target(
             "raster depth buffer (MSAA)",
-            width,
-            height,
             TexelFormat::D32Float,
             attachment(true, false, MSAA_SAMPLES),
         )?;
         // storage: splat's input pass reads it where the frame stays on the GPU
-        let color = Image::new_2d(
-            ctx,
+        let color = target(
             "raster colour",
-            width,
-            height,
             TexelFormat::Rgba32Float,
             ImageUsage {
                 storage: true,
@@ -327,11 +319,8 @@ impl Rasterizer {
             Some(&depth_ms),
         )?;
         // storage: where peeled layers stay on the GPU, splat's input pass writes it
-        let previous_depth = Image::new_2d(
-            ctx,
+        let previous_depth = target(
             "raster previous layer depth",
-            width,
-            height,
             TexelFormat::R32Float,
             ImageUsage {
                 storage: true,

@@ -258,33 +258,28 @@ impl ParamSpec {
                 ));
             }
         }
-        for n in 1..=groups.anterior_elevation_order.min(6) {
-            let b = if n <= 4 { 0.10 } else { 0.05 };
+        // The elevation terms (n, m), m = −n, −n + 2, …, n, of one corneal surface (0 anterior,
+        // 1 posterior), each within ±bound mm.
+        let elevation = |v: &mut Vec<ParamSpec>, surface: usize, n: u32, bound: f64| {
+            let side = ["anterior", "posterior"][surface];
             for k in 0..=n {
                 let m = 2 * k as i32 - n as i32;
                 v.push(p(
-                    &format!("cornea.anterior.elevation({n},{m})_mm"),
-                    Field::Elevation(0, n, m),
+                    &format!("cornea.{side}.elevation({n},{m})_mm"),
+                    Field::Elevation(surface, n, m),
                     0.0,
                     0.0,
-                    [-b, b],
+                    [-bound, bound],
                     1.0,
                 ));
             }
+        };
+        for n in 1..=groups.anterior_elevation_order.min(6) {
+            elevation(&mut v, 0, n, if n <= 4 { 0.10 } else { 0.05 });
         }
         if groups.posterior_elevation {
             for n in 5..=6u32 {
-                for k in 0..=n {
-                    let m = 2 * k as i32 - n as i32;
-                    v.push(p(
-                        &format!("cornea.posterior.elevation({n},{m})_mm"),
-                        Field::Elevation(1, n, m),
-                        0.0,
-                        0.0,
-                        [-0.05, 0.05],
-                        1.0,
-                    ));
-                }
+                elevation(&mut v, 1, n, 0.05);
             }
         }
         v
