@@ -52,6 +52,14 @@ impl GridAxes {
         self.objects.count * self.focus_d.len() * self.pupils_mm.len() * 3
     }
 
+    /// The (pupil mm, focus D) of every column of the grid, pupil-major.
+    pub fn column_states(&self) -> Vec<(f64, f64)> {
+        self.pupils_mm
+            .iter()
+            .flat_map(|&p| self.focus_d.iter().map(move |&f| (p, f)))
+            .collect()
+    }
+
     /// Checks ranges; the message names the axis and what is allowed.
     pub fn validate(&self) -> Result<(), String> {
         let o = &self.objects;

@@ -187,11 +187,7 @@ pub fn compute_kernel_field(
             }
         }
     }
-    let pairs: Vec<(f64, f64)> = axes
-        .pupils_mm
-        .iter()
-        .flat_map(|&p| axes.focus_d.iter().map(move |&f| (p, f)))
-        .collect();
+    let pairs = axes.column_states();
     // Every node's PSFs first: the common largest radius is the largest natural one.
     let mut staged = Vec::with_capacity(nodes.len());
     for (i, &n) in nodes.iter().enumerate() {

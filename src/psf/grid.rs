@@ -110,11 +110,7 @@ pub(super) fn measure_columns(
     field_deg: [f64; 2],
     progress: Progress,
 ) -> Result<Vec<ColumnOptics>> {
-    let pairs: Vec<(f64, f64)> = axes
-        .pupils_mm
-        .iter()
-        .flat_map(|&p| axes.focus_d.iter().map(move |&f| (p, f)))
-        .collect();
+    let pairs = axes.column_states();
     let done = AtomicUsize::new(0);
     pairs
         .par_iter()
