@@ -6,21 +6,14 @@
 
 use crate::common;
 
-use common::synthetic::{ExactSynthetic, SyntheticEye};
+use common::pixels::opaque_pixels;
+use common::synthetic::{ExactSynthetic, SyntheticEye, NO_MERGE};
 use ocular::psf::kernels::{
     kernel_side, level_block_radius, level_of_radius, DioptreAxis, KernelGrid,
 };
 use ocular::render::blend::{BlendMode, BlendSettings};
 use ocular::render::reference::{self, ExactKernels};
-use ocular::render::splat::{FrameInput, MergeSettings, SplatSettings, Splatter, ViewState};
-
-const NO_MERGE: MergeSettings = MergeSettings {
-    levels: 0,
-    blur_per_block: 0.0,
-    min_radius_px: 5.0,
-    color_error: MergeSettings::DEFAULT_COLOR_ERROR,
-    dioptre_tolerance: 0.01,
-};
+use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
 
 struct Frame {
     w: usize,
@@ -37,14 +30,7 @@ impl Frame {
         fov_y_deg: f64,
         f: impl Fn(usize, usize) -> ([f32; 3], f32),
     ) -> Self {
-        let (mut color, mut depth) = (Vec::new(), Vec::new());
-        for y in 0..h {
-            for x in 0..w {
-                let (c, d) = f(x, y);
-                color.push([c[0], c[1], c[2], 1.0]);
-                depth.push(d);
-            }
-        }
+        let (color, depth) = opaque_pixels(w as u32, h as u32, |x, y| f(x as usize, y as usize));
         Frame {
             w,
             h,

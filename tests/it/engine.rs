@@ -6,7 +6,7 @@
 
 use crate::common;
 
-use common::pixels::max_rgb_difference;
+use common::pixels::{max_rgb_difference, opaque_pixels};
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};
 use ocular::render::blend::{BlendMode, BlendSettings};
@@ -26,14 +26,7 @@ const H: u32 = 64;
 
 impl Frame {
     fn new(f: impl Fn(u32, u32) -> ([f32; 3], f32)) -> Frame {
-        let (mut color, mut depth) = (Vec::new(), Vec::new());
-        for y in 0..H {
-            for x in 0..W {
-                let (c, d) = f(x, y);
-                color.push([c[0], c[1], c[2], 1.0]);
-                depth.push(d);
-            }
-        }
+        let (color, depth) = opaque_pixels(W, H, f);
         Frame { color, depth }
     }
 

@@ -7,13 +7,11 @@
 
 use crate::common;
 
-use common::pixels::max_rgb_difference;
+use common::pixels::{hidden_layers, max_rgb_difference};
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::{DioptreAxis, KernelGrid};
 use ocular::render::blend::BlendSettings;
-use ocular::render::splat::{
-    FrameInput, HiddenLayer, SplatOutput, SplatSettings, Splatter, ViewState,
-};
+use ocular::render::splat::{FrameInput, SplatOutput, SplatSettings, Splatter, ViewState};
 use ocular::render::{Frame, Rasterizer};
 use ocular::scene::{FrameState, Scene};
 
@@ -55,13 +53,7 @@ fn splat_host(
     visible: &Frame,
     hidden: &[&Frame],
 ) -> SplatOutput {
-    let hidden: Vec<HiddenLayer<'_>> = hidden
-        .iter()
-        .map(|f| HiddenLayer {
-            color: &f.color,
-            depth_m: &f.depth_m,
-        })
-        .collect();
+    let hidden = hidden_layers(hidden.iter().copied());
     let input = FrameInput {
         width: W,
         height: H,

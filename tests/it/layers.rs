@@ -7,11 +7,11 @@ use crate::common;
 
 use std::path::Path;
 
-use common::pixels::max_rgb_difference;
+use common::pixels::{hidden_layers, max_rgb_difference};
 use common::synthetic::SyntheticEye;
 use ocular::psf::kernels::DioptreAxis;
 use ocular::render::blend::DEFAULT_GROUP_TOLERANCE_D;
-use ocular::render::splat::{FrameInput, HiddenLayer, SplatSettings, Splatter, ViewState};
+use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
 use ocular::render::{Frame, Rasterizer};
 use ocular::scene::Scene;
 
@@ -31,6 +31,15 @@ fn focal_px() -> f64 {
 /// the parallax that decides what a hidden point shows through must match the kernels.
 fn pupil_mm() -> f64 {
     2000.0 * PX_PER_D / focal_px()
+}
+
+/// The grey self-lit card at 0.25 m whose right edge is the frame's centre column.
+fn card_object() -> String {
+    format!(
+        "\n[[object]]\nkind = \"plane\"\nsize_m = 1.0\ntranslate = [-0.5, 0.0, {}]\n\
+         color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 40.0\n",
+        -CARD_M
+    )
 }
 
 /// A self-lit checkerboard wall (squares of 5 px) at 2 m, optionally a grey self-lit card at
@@ -57,11 +66,7 @@ fn scene(card: bool, sphere: bool) -> Scene {
         }
     }
     if card {
-        text += &format!(
-            "\n[[object]]\nkind = \"plane\"\nsize_m = 1.0\ntranslate = [-0.5, 0.0, {}]\n\
-             color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 40.0\n",
-            -CARD_M
-        );
+        text += &card_object();
     }
     if sphere {
         text += "\n[[object]]\nkind = \"sphere\"\nradius_m = 0.1\ntranslate = [0.2, 0.0, -1.0]\n\
@@ -108,13 +113,7 @@ fn splat_focused(frames: &[Frame], focus_d: f64, pupil_visibility: bool) -> Vec<
         ..SplatSettings::default()
     };
     let mut splatter = Splatter::new(&ctx, grid, settings).unwrap();
-    let hidden: Vec<HiddenLayer<'_>> = frames[1..]
-        .iter()
-        .map(|f| HiddenLayer {
-            color: &f.color,
-            depth_m: &f.depth_m,
-        })
-        .collect();
+    let hidden = hidden_layers(&frames[1..]);
     let input = FrameInput {
         width: W,
         height: H,
@@ -299,11 +298,7 @@ fn stripe_scene(card: bool) -> Scene {
         -WALL_M + 0.001
     );
     if card {
-        text += &format!(
-            "\n[[object]]\nkind = \"plane\"\nsize_m = 1.0\ntranslate = [-0.5, 0.0, {}]\n\
-             color = [0.0, 0.0, 0.0]\nemission_cd_m2 = 40.0\n",
-            -CARD_M
-        );
+        text += &card_object();
     }
     Scene::from_toml(&text, "stripe behind a card", Path::new(".")).unwrap()
 }

@@ -3,6 +3,7 @@
 
 use crate::common;
 
+use common::pixels::opaque_pixels;
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::metrics::{psnr, ssim, ImageView};
 use ocular::psf::kernels::DioptreAxis;
@@ -13,27 +14,21 @@ use ocular::render::{reference, slices};
 #[test]
 fn slices_are_finite_and_clearly_worse_than_splatting() {
     let (w, h) = (160usize, 90usize);
-    let mut color = Vec::new();
-    let mut depth = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            let t = [
-                (0.21 * x as f32).sin(),
-                (0.17 * y as f32).cos(),
-                (0.09 * (x + y) as f32).sin(),
-            ];
-            let c = t.map(|v| 0.5 + 0.45 * v);
-            let d = if (60..110).contains(&x) && (20..60).contains(&y) {
-                1.0 / 3.0
-            } else if (20..80).contains(&x) && (40..80).contains(&y) {
-                1.0 / 1.5
-            } else {
-                1.0 / 0.4
-            };
-            color.push([c[0], c[1], c[2], 1.0]);
-            depth.push(d);
-        }
-    }
+    let (color, depth) = opaque_pixels(w as u32, h as u32, |x, y| {
+        let t = [
+            (0.21 * x as f32).sin(),
+            (0.17 * y as f32).cos(),
+            (0.09 * (x + y) as f32).sin(),
+        ];
+        let d = if (60..110).contains(&x) && (20..60).contains(&y) {
+            1.0 / 3.0
+        } else if (20..80).contains(&x) && (40..80).contains(&y) {
+            1.0 / 1.5
+        } else {
+            1.0 / 0.4
+        };
+        (t.map(|v| 0.5 + 0.45 * v), d)
+    });
     let input = FrameInput {
         width: w as u32,
         height: h as u32,

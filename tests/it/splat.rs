@@ -4,9 +4,9 @@
 
 use crate::common;
 
-use common::pixels::{max_rgb_difference, psnr};
+use common::pixels::{max_rgb_difference, opaque_pixels, psnr};
 use common::splat_cpu;
-use common::synthetic::{ExactSynthetic, SyntheticEye};
+use common::synthetic::{ExactSynthetic, SyntheticEye, NO_MERGE};
 use ocular::gpu::texture_probe::TextureProbe;
 use ocular::gpu::Context;
 use ocular::psf::kernels::{
@@ -18,14 +18,6 @@ use ocular::render::splat::{
     FrameInput, MergeSettings, PsfTextureFormat, SplatOutput, SplatSettings, Splatter, ViewState,
 };
 
-const NO_MERGE: MergeSettings = MergeSettings {
-    levels: 0,
-    blur_per_block: 0.0,
-    min_radius_px: 5.0,
-    color_error: MergeSettings::DEFAULT_COLOR_ERROR,
-    dioptre_tolerance: 0.01,
-};
-
 struct Scene {
     width: u32,
     height: u32,
@@ -35,15 +27,7 @@ struct Scene {
 
 impl Scene {
     fn new(width: u32, height: u32, f: impl Fn(u32, u32) -> ([f32; 3], f32)) -> Scene {
-        let mut color = Vec::new();
-        let mut depth = Vec::new();
-        for y in 0..height {
-            for x in 0..width {
-                let (c, d) = f(x, y);
-                color.push([c[0], c[1], c[2], 1.0]);
-                depth.push(d);
-            }
-        }
+        let (color, depth) = opaque_pixels(width, height, f);
         Scene {
             width,
             height,

@@ -4,7 +4,7 @@
 //! radius is exercised.
 
 use crate::common;
-use common::pixels::psnr;
+use common::pixels::{opaque_pixels, psnr};
 
 use ocular::eye::Eye;
 use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
@@ -27,21 +27,15 @@ fn texture(x: u32, y: u32, seed: f32) -> [f32; 3] {
 #[test]
 fn real_kernels_splat_like_the_ground_truth() {
     let (w, h) = (120u32, 72u32);
-    let mut color = Vec::new();
-    let mut depth = Vec::new();
-    for y in 0..h {
-        for x in 0..w {
-            let (c, d) = if (60..100).contains(&x) && (14..44).contains(&y) {
-                (texture(x, y, 2.0), 1.0 / 3.1)
-            } else if (15..70).contains(&x) && (30..64).contains(&y) {
-                (texture(x, y, 1.0), 1.0 / 1.4)
-            } else {
-                (texture(x, y, 0.0), 1.0 / 0.45)
-            };
-            color.push([c[0], c[1], c[2], 1.0]);
-            depth.push(d);
+    let (color, depth) = opaque_pixels(w, h, |x, y| {
+        if (60..100).contains(&x) && (14..44).contains(&y) {
+            (texture(x, y, 2.0), 1.0 / 3.1)
+        } else if (15..70).contains(&x) && (30..64).contains(&y) {
+            (texture(x, y, 1.0), 1.0 / 1.4)
+        } else {
+            (texture(x, y, 0.0), 1.0 / 0.45)
         }
-    }
+    });
     let screen = Screen {
         fov_y_deg: 3.0,
         height_px: h,

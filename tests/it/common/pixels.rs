@@ -1,5 +1,34 @@
-//! Comparisons of RGBA images over their colour channels (alpha is not compared), written for
-//! the tests.
+//! Synthetic RGBA frames, and comparisons of RGBA images over their colour channels (alpha is
+//! not compared), written for the tests.
+
+use ocular::render::splat::HiddenLayer;
+use ocular::render::Frame;
+
+/// Rasterised layers as the splatter's hidden layers, in the order given.
+pub fn hidden_layers<'a>(frames: impl IntoIterator<Item = &'a Frame>) -> Vec<HiddenLayer<'a>> {
+    frames
+        .into_iter()
+        .map(|f| HiddenLayer {
+            color: &f.color,
+            depth_m: &f.depth_m,
+        })
+        .collect()
+}
+
+/// An opaque frame's colour and depth, row by row, each pixel's from `f(x, y)`.
+pub fn opaque_pixels(
+    width: u32,
+    height: u32,
+    f: impl Fn(u32, u32) -> ([f32; 3], f32),
+) -> (Vec<[f32; 4]>, Vec<f32>) {
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let ([r, g, b], d) = f(x, y);
+            ([r, g, b, 1.0], d)
+        })
+        .unzip()
+}
 
 /// The largest absolute difference of any colour channel at any pixel.
 pub fn max_rgb_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {

@@ -7,6 +7,16 @@ use ocular::psf::kernels::{
     level_block_radius, level_count, level_radius_px, DioptreAxis, KernelGrid, KernelSet,
 };
 use ocular::render::reference::{ExactKernels, Kernel};
+use ocular::render::splat::MergeSettings;
+
+/// No merge levels: every pixel is splatted at full resolution, as the exact reference sums.
+pub const NO_MERGE: MergeSettings = MergeSettings {
+    levels: 0,
+    blur_per_block: 0.0,
+    min_radius_px: 5.0,
+    color_error: MergeSettings::DEFAULT_COLOR_ERROR,
+    dioptre_tolerance: 0.01,
+};
 
 #[derive(Clone, Debug)]
 pub struct SyntheticEye {
