@@ -57,34 +57,31 @@ pub fn write_single_part(path: &Path, (w, h): (usize, usize), planes: Vec<Plane>
 }
 
 /// A multi-part file: each part named, with its own channels.
-pub fn write_multi_part(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, Vec<Plane>)>) {
-    let layers: Vec<Layer<AnyChannels<FlatSamples>>> = parts
+pub fn write_multi_part(path: &Path, size: (usize, usize), parts: Vec<(&str, Vec<Plane>)>) {
+    let parts = parts
         .into_iter()
-        .map(|(name, planes)| {
-            Layer::new(
-                (w, h),
-                LayerAttributes::named(name),
-                Encoding::FAST_LOSSLESS,
-                channels(planes),
-            )
-        })
+        .map(|(name, planes)| (LayerAttributes::named(name), planes))
         .collect();
-    Image::from_layers(
-        ImageAttributes::new(IntegerBounds::from_dimensions((w, h))),
-        layers,
-    )
-    .write()
-    .to_file(path)
-    .unwrap();
+    write_parts(path, size, parts);
 }
 
 /// A stereo multi-part file: one part per (name, view), the `view` attribute set.
-pub fn write_views(path: &Path, (w, h): (usize, usize), parts: Vec<(&str, &str, Vec<Plane>)>) {
-    let layers: Vec<Layer<AnyChannels<FlatSamples>>> = parts
+pub fn write_views(path: &Path, size: (usize, usize), parts: Vec<(&str, &str, Vec<Plane>)>) {
+    let parts = parts
         .into_iter()
         .map(|(name, view, planes)| {
             let mut attributes = LayerAttributes::named(name);
             attributes.view_name = Some(Text::from(view));
+            (attributes, planes)
+        })
+        .collect();
+    write_parts(path, size, parts);
+}
+
+fn write_parts(path: &Path, (w, h): (usize, usize), parts: Vec<(LayerAttributes, Vec<Plane>)>) {
+    let layers: Vec<Layer<AnyChannels<FlatSamples>>> = parts
+        .into_iter()
+        .map(|(attributes, planes)| {
             Layer::new(
                 (w, h),
                 attributes,
