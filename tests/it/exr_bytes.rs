@@ -1,19 +1,14 @@
 //! EXR output is byte-deterministic: identical pixels give identical files (issue 20, defect 6),
 //! which checksums, caches and split verification depend on.
 
-use crate::common::temp_dir;
+use crate::common::{temp_dir, xorshift};
 use ocular::image_io::{write_exr_depth, write_exr_rgba, ImageGray, ImageRgba};
 
 /// Noise that RLE cannot shrink, so every tile costs a different compression time and a
 /// writer that emits blocks as they finish would vary its order.
 fn noisy(width: u32, height: u32) -> ImageRgba {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut bits = xorshift(0x2545_f491_4f6c_dd1d);
+    let mut next = move || (bits() >> 40) as f32 / (1u64 << 24) as f32;
     let pixels = (0..width * height)
         .map(|i| {
             // Flat runs in some rows make tiles unequal in cost.

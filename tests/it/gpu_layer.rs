@@ -50,13 +50,8 @@ fn trilinear(texels: &[[f32; 4]], [w, h, d]: [u32; 3], p: [f32; 3]) -> [f32; 4] 
 
 /// Deterministic pseudo-random sample points, including some in the border band.
 fn probe_points([w, h, d]: [u32; 3], count: usize) -> Vec<[f32; 3]> {
-    let mut state = 0x9E37_79B9_7F4A_7C15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut bits = common::xorshift(0x9E37_79B9_7F4A_7C15);
+    let mut next = move || (bits() >> 11) as f64 / (1u64 << 53) as f64;
     (0..count)
         .map(|_| {
             // Range [-1, size + 1]: covers the zero border on every side.

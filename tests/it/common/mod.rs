@@ -74,6 +74,16 @@ fn folder(suffix: &str) -> PathBuf {
     std::env::temp_dir().join(format!("ocular-it-{pid}-{module}{suffix}"))
 }
 
+/// Marsaglia's xorshift64 from `state` (not zero): noise that every run repeats.
+pub fn xorshift(mut state: u64) -> impl FnMut() -> u64 {
+    move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    }
+}
+
 /// A file of tests/data.
 pub fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
