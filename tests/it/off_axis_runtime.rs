@@ -7,6 +7,7 @@
 //! `cargo test --release --test it off_axis_runtime:: -- --nocapture`.
 
 use crate::common;
+use common::frames::{frame_renderer, splat_and_truth};
 use common::pixels::max_rgb_difference;
 
 use ocular::eye::file::resolve;
@@ -111,34 +112,30 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
     let kernels = prepare_kernels(&eye, &needs, &options).unwrap();
     let field = kernels.field.as_ref().expect("off-axis kernels").clone();
     let rmax = kernels.grid.max_radius_px;
-    let mut renderer = FrameRenderer::new(
-        &ctx,
-        eye.clone(),
-        kernels,
-        options.settings.clone(),
-        SplatSettings::default(),
-    );
+    let mut renderer = frame_renderer(&ctx, eye.clone(), kernels, &options);
     renderer.reference_field_step_deg = REFERENCE_STEP_DEG;
-    let splat = renderer.render(&input, state, Method::Splat).unwrap().color;
-    let truth = renderer
-        .render(&input, state, Method::Reference)
-        .unwrap()
-        .color;
-    // The off-axis convolution is a pipeline of its own: tile sizes give the same image (32 is
-    // refused: on lavapipe the four-node convolution at 16 pixels per thread went wrong).
-    {
-        let tile_size = 16;
-        let mut r = FrameRenderer::new(
+    let (splat, truth) = splat_and_truth(&mut renderer, &input, state);
+    // A fresh renderer of the same kernels splatting with other settings.
+    let splat_with = |settings: SplatSettings| {
+        FrameRenderer::new(
             &ctx,
             eye.clone(),
             prepare_kernels(&eye, &needs, &options).unwrap(),
             options.settings.clone(),
-            SplatSettings {
-                tile_size,
-                ..SplatSettings::default()
-            },
-        );
-        let other = r.render(&input, state, Method::Splat).unwrap().color;
+            settings,
+        )
+        .render(&input, state, Method::Splat)
+    };
+    // The off-axis convolution is a pipeline of its own: tile sizes give the same image (32 is
+    // refused: on lavapipe the four-node convolution at 16 pixels per thread went wrong).
+    {
+        let tile_size = 16;
+        let other = splat_with(SplatSettings {
+            tile_size,
+            ..SplatSettings::default()
+        })
+        .unwrap()
+        .color;
         let worst = max_rgb_difference(&other, &splat);
         assert!(
             worst <= 1e-6,
@@ -148,17 +145,12 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
     // The GPU's walk (convolve.comp, its reads planned per batch) gives the visits walk's image
     // off axis too, up to the order of float additions.
     {
-        let mut r = FrameRenderer::new(
-            &ctx,
-            eye.clone(),
-            prepare_kernels(&eye, &needs, &options).unwrap(),
-            options.settings.clone(),
-            SplatSettings {
-                convolve_walk: ConvolveWalk::Pixels,
-                ..SplatSettings::default()
-            },
-        );
-        let pixels = r.render(&input, state, Method::Splat).unwrap().color;
+        let pixels = splat_with(SplatSettings {
+            convolve_walk: ConvolveWalk::Pixels,
+            ..SplatSettings::default()
+        })
+        .unwrap()
+        .color;
         let worst = max_rgb_difference(&pixels, &splat);
         eprintln!("off axis: worst difference between the walks {worst:.2e}");
         assert!(
@@ -166,30 +158,17 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
             "the pixel walk differs off axis by {worst:e}"
         );
     }
-    let refused = FrameRenderer::new(
-        &ctx,
-        eye.clone(),
-        prepare_kernels(&eye, &needs, &options).unwrap(),
-        options.settings.clone(),
-        SplatSettings {
-            tile_size: 32,
-            ..SplatSettings::default()
-        },
-    )
-    .render(&input, state, Method::Splat)
+    let refused = splat_with(SplatSettings {
+        tile_size: 32,
+        ..SplatSettings::default()
+    })
     .err()
     .expect("--off-axis with 32-pixel tiles is refused")
     .to_string();
     assert!(refused.contains("--tile-size 8 or 16"), "{refused}");
     let on_axis = {
         let k = prepare_kernels(&eye, &needs, &on_axis_options).unwrap();
-        let mut r = FrameRenderer::new(
-            &ctx,
-            eye,
-            k,
-            on_axis_options.settings.clone(),
-            SplatSettings::default(),
-        );
+        let mut r = frame_renderer(&ctx, eye, k, &on_axis_options);
         r.render(&input, state, Method::Splat).unwrap().color
     };
     let margin = rmax as usize + 2;

@@ -6,15 +6,14 @@
 //! `cargo test --release --test it plane_four_eyes:: -- --nocapture`.
 
 use crate::common;
+use common::frames::{frame_renderer, splat_and_truth};
 
 use ocular::eye::file::resolve;
 use ocular::psf::axes::Screen;
 use ocular::psf::exact::ExactEye;
-use ocular::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
-};
+use ocular::render::frame::{dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions};
 use ocular::render::reference::{ExactKernels, DIOPTRE_BIN_D};
-use ocular::render::splat::{FrameInput, SplatSettings};
+use ocular::render::splat::FrameInput;
 
 const W: usize = 160;
 const H: usize = 90;
@@ -108,22 +107,12 @@ fn a_plane_through_the_four_eyes_is_its_convolution() {
                 max_radius,
             )
             .unwrap();
-            let mut renderer = FrameRenderer::new(
-                &ctx,
-                eye,
-                kernels,
-                options.settings.clone(),
-                SplatSettings::default(),
-            );
+            let mut renderer = frame_renderer(&ctx, eye, kernels, &options);
             // The plane's vergence at the frame's centre, in the ground truth's bins.
             let d = (1.0 / f64::from(distance_m) / DIOPTRE_BIN_D).round() * DIOPTRE_BIN_D;
             let k = [0, 1, 2].map(|c| exact.kernel(c, d));
             let margin = k.iter().map(|k| k.radius as usize).max().unwrap() + 1;
-            let splat = renderer.render(&input, state, Method::Splat).unwrap().color;
-            let truth = renderer
-                .render(&input, state, Method::Reference)
-                .unwrap()
-                .color;
+            let (splat, truth) = splat_and_truth(&mut renderer, &input, state);
             let db_splat = psnr_against_convolution(&splat, &color, &k, margin);
             let db_truth = psnr_against_convolution(&truth, &color, &k, margin);
             eprintln!(

@@ -5,14 +5,15 @@
 //! that the blur reaches 10–30 px on a small frame.
 
 use crate::common;
+use common::frames::{frame_renderer, splat_and_truth};
 
 use ocular::eye::file::resolve;
 use ocular::metrics::{psnr, ssim, ImageView};
 use ocular::psf::axes::Screen;
 use ocular::render::frame::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+    dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions, Method,
 };
-use ocular::render::splat::{FrameInput, SplatSettings};
+use ocular::render::splat::FrameInput;
 
 const W: u32 = 96;
 const H: u32 = 54;
@@ -93,18 +94,8 @@ fn four_preset_eyes_match_the_ground_truth() {
         let needs = scene_needs(&[dioptre_range(&depth, W, H, FOV_Y_DEG)], &[state], screen);
         let kernels = prepare_kernels(&eye, &needs, &options).unwrap();
         let max_radius = kernels.grid.max_radius_px;
-        let mut renderer = FrameRenderer::new(
-            &ctx,
-            eye,
-            kernels,
-            options.settings.clone(),
-            SplatSettings::default(),
-        );
-        let splat = renderer.render(&input, state, Method::Splat).unwrap().color;
-        let truth = renderer
-            .render(&input, state, Method::Reference)
-            .unwrap()
-            .color;
+        let mut renderer = frame_renderer(&ctx, eye, kernels, &options);
+        let (splat, truth) = splat_and_truth(&mut renderer, &input, state);
         let v = |p| ImageView::new(W as usize, H as usize, p);
         let sliced = renderer
             .render(&input, state, Method::Slices)

@@ -128,6 +128,7 @@ pub fn refused(out: &Output, words: &[&str]) -> String {
 }
 
 pub mod blender;
+pub mod frames;
 pub mod pixels;
 pub mod scenes;
 pub mod splat_cpu;
