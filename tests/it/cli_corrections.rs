@@ -2,7 +2,7 @@
 //! prescription → eye → prescription loop through `eye estimate`, `eye refract` and
 //! `eye measure --correct`, and `render --json` reporting a clamped focus (lavapipe, 160×90).
 
-use crate::common::{json_ok, ocular_run, temp_dir};
+use crate::common::{eye_measure, eye_refract, json_ok, ocular_run, temp_dir};
 
 #[test]
 fn every_new_option_is_range_checked_at_the_parser() {
@@ -78,16 +78,7 @@ fn prescription_to_eye_to_prescription_closes() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for vertex in ["0", "12"] {
-        let r = json_ok(&ocular_run(&[
-            "eye",
-            "refract",
-            eye,
-            "--pupil-mm",
-            "4",
-            "--vertex-mm",
-            vertex,
-            "--json",
-        ]));
+        let r = json_ok(&eye_refract(eye, "4", &["--vertex-mm", vertex, "--json"]));
         // Independent: each principal meridian's power K at the entrance pupil moves to
         // F = K / (1 + dK) at the lens, d from the lens to the pupil.
         let ep = r["eye_entrance_pupil_z_mm"].as_f64().unwrap();
@@ -112,43 +103,53 @@ fn prescription_to_eye_to_prescription_closes() {
         assert!((got_a - a).abs() < 1.0, "vertex {vertex}: axis {got_a}");
         // The printed form goes straight back in as --correct and corrects the eye.
         let rx = r["rx"].as_str().unwrap();
-        let m = json_ok(&ocular_run(&[
-            "eye",
-            "measure",
+        let m = json_ok(&eye_measure(
             eye,
-            "--pupil-mm",
             "4",
-            "--wavelength-nm",
             "549",
-            "--correct",
-            rx,
-            "--vertex-mm",
-            vertex,
-            "--json",
-        ]));
+            &["--correct", rx, "--vertex-mm", vertex, "--json"],
+        ));
         for k in ["m", "j0", "j45"] {
             let v = m["refraction"][k].as_f64().unwrap();
             assert!(v.abs() < 0.05, "vertex {vertex}: through {rx}, {k} = {v}");
         }
         // Negative control: the same lens at the other vertex distance leaves an error.
         let other = if vertex == "0" { "12" } else { "0" };
-        let m = json_ok(&ocular_run(&[
-            "eye",
-            "measure",
+        let m = json_ok(&eye_measure(
             eye,
-            "--pupil-mm",
             "4",
-            "--wavelength-nm",
             "549",
-            "--correct",
-            rx,
-            "--vertex-mm",
-            other,
-            "--json",
-        ]));
+            &["--correct", rx, "--vertex-mm", other, "--json"],
+        ));
         assert!(m["refraction"]["m"].as_f64().unwrap().abs() > 0.05);
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `ocular render` of `scene` at 160×90 through `eye` focused at `focus_m`, with `extra`,
+/// written into `dir`: its JSON summary.
+fn render_json(
+    dir: &std::path::Path,
+    (scene, eye, focus_m): (&str, &str, &str),
+    extra: &[&str],
+) -> serde_json::Value {
+    let out = dir.join("out.png");
+    let mut args = vec![
+        "render",
+        "--scene",
+        scene,
+        "--eye",
+        eye,
+        "--focus-m",
+        focus_m,
+        "--size",
+        "160x90",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    json_ok(&ocular_run(&args))
 }
 
 #[test]
@@ -156,25 +157,8 @@ fn render_reports_the_near_point_and_reading_glasses_move_it() {
     let dir = temp_dir("render");
     let cache = dir.join("cache");
     let render = |extra: &[&str]| {
-        let out = dir.join("out.png");
-        let mut args = vec![
-            "render",
-            "--scene",
-            "chart",
-            "--eye",
-            "healthy",
-            "--size",
-            "160x90",
-            "--focus-m",
-            "0.4",
-            "--json",
-            "--cache",
-            cache.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        json_ok(&ocular_run(&args))
+        let cached = [&["--cache", cache.to_str().unwrap()][..], extra].concat();
+        render_json(&dir, ("chart", "healthy", "0.4"), &cached)
     };
     let old = render(&["--age", "60"]);
     assert_eq!(old["focus_d"].as_f64().unwrap(), 2.5);
@@ -207,26 +191,8 @@ fn the_myopic_eye_focuses_far_only_through_its_prescription() {
         .unwrap()
         .to_string();
     let render = |extra: &[&str]| {
-        let out = dir.join("out.png");
-        let mut args = vec![
-            "render",
-            "--scene",
-            "primitives",
-            "--eye",
-            "myopia",
-            "--size",
-            "160x90",
-            "--focus-m",
-            "inf",
-            "--pupil-mm",
-            "4",
-            "--json",
-            "--no-cache",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        json_ok(&ocular_run(&args))
+        let args = [&["--pupil-mm", "4", "--no-cache"][..], extra].concat();
+        render_json(&dir, ("primitives", "myopia", "inf"), &args)
     };
     let bare = render(&[]);
     assert_eq!(bare["focus_limit"], "far_point");

@@ -1,7 +1,7 @@
 //! `ocular eye …` end to end: estimation from a prescription (eye file, JSON, plot), an
 //! interrupted run, presets, measurement JSON, drawing, and bad input refused with exit 2.
 
-use crate::common::{self, ocular, ocular_run, ok, temp_dir};
+use crate::common::{self, eye_measure, json_ok, ocular, ocular_run, ok, temp_dir};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -47,17 +47,7 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
     // The file is an eye like any other.
     let shown = ok(&ocular_run(&["eye", "show", &s(&eye)]));
     assert!(shown.contains("estimated from a 4 mm"), "{shown}");
-    let m: serde_json::Value = serde_json::from_str(&ok(&ocular_run(&[
-        "eye",
-        "measure",
-        &s(&eye),
-        "--pupil-mm",
-        "4",
-        "--wavelength-nm",
-        "549",
-        "--json",
-    ])))
-    .unwrap();
+    let m = json_ok(&eye_measure(&s(&eye), "4", "549", &["--json"]));
     // "-3 -1 x 20" is a spectacle 12 mm in front of the cornea (taken at 549 nm): its
     // meridians −3 and −4 D reach the entrance pupil as P/(1 − dP), d = 12 mm + the pupil's
     // depth (which `eye refract` reports).
@@ -131,17 +121,7 @@ fn list_show_measure_draw() {
         assert!(r.rms_error_um <= 0.02, "{name}: {}", r.rms_error_um);
     }
     ok(&ocular_run(&["eye", "show", "myopia"]));
-    let m: serde_json::Value = serde_json::from_str(&ok(&ocular_run(&[
-        "eye",
-        "measure",
-        "navarro",
-        "--pupil-mm",
-        "6",
-        "--wavelength-nm",
-        "555",
-        "--json",
-    ])))
-    .unwrap();
+    let m = json_ok(&eye_measure("navarro", "6", "555", &["--json"]));
     let c40 = m["coefficients"]
         .as_array()
         .unwrap()
@@ -227,30 +207,9 @@ fn bad_input_is_refused_with_exit_code_2() {
         "bad_eye.toml",
     );
     refused(&ocular_run(&["eye", "show", "no-such-eye"]), "no-such-eye");
+    refused(&eye_measure("navarro", "12", "555", &[]), "--pupil-mm");
     refused(
-        &ocular_run(&[
-            "eye",
-            "measure",
-            "navarro",
-            "--pupil-mm",
-            "12",
-            "--wavelength-nm",
-            "555",
-        ]),
-        "--pupil-mm",
-    );
-    refused(
-        &ocular_run(&[
-            "eye",
-            "measure",
-            "navarro",
-            "--pupil-mm",
-            "4",
-            "--wavelength-nm",
-            "555",
-            "--focus-m",
-            "-1",
-        ]),
+        &eye_measure("navarro", "4", "555", &["--focus-m", "-1"]),
         "--focus-m",
     );
 }

@@ -2,23 +2,17 @@
 //! used), its range checks, and the retina in eye files (old files load with the wide-angle
 //! retina, a plane is accepted, bad radii and unknown shapes are refused).
 
-use crate::common::{json_ok, ocular_run, ok, refused, temp_dir};
+use crate::common::{eye_measure, json_ok, ocular_run, ok, refused, temp_dir};
 use ocular::eye::{Eye, Retina};
 use std::process::Output;
 
 fn measure_json(field: &str) -> serde_json::Value {
-    json_ok(&ocular_run(&[
-        "eye",
-        "measure",
+    json_ok(&eye_measure(
         "navarro-wide",
-        "--pupil-mm",
         "4",
-        "--wavelength-nm",
         "555",
-        "--field-deg",
-        field,
-        "--json",
-    ]))
+        &["--field-deg", field, "--json"],
+    ))
 }
 
 #[test]
@@ -49,17 +43,7 @@ fn measure_off_axis_prints_the_on_axis_json_and_its_pupil() {
 #[test]
 fn field_option_is_range_checked() {
     for bad in ["61,0", "0,-70", "55,55", "nan,0", "10", "a,b", "1,2,3"] {
-        let out = ocular_run(&[
-            "eye",
-            "measure",
-            "navarro-wide",
-            "--pupil-mm",
-            "4",
-            "--wavelength-nm",
-            "555",
-            "--field-deg",
-            bad,
-        ]);
+        let out = eye_measure("navarro-wide", "4", "555", &["--field-deg", bad]);
         refused(&out, &["--field-deg"]);
     }
 }
@@ -124,29 +108,17 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     use ocular::psf::cache::read_grid;
     let dir = temp_dir("field");
     let index = dir.join("field.toml");
-    let out = kernels(
-        &dir,
-        &[
-            "--field-deg",
-            "-30..30:3,0..0:1",
-            "-o",
-            index.to_str().unwrap(),
-        ],
-    );
-    ok(&out);
+    let field = [
+        "--field-deg",
+        "-30..30:3,0..0:1",
+        "-o",
+        index.to_str().unwrap(),
+    ];
+    ok(&kernels(&dir, &field));
     let text = std::fs::read_to_string(&index).unwrap();
     assert_eq!(text.matches("[[node]]").count(), 3);
     assert_eq!(text.matches("cached = false").count(), 3);
-    let again = kernels(
-        &dir,
-        &[
-            "--field-deg",
-            "-30..30:3,0..0:1",
-            "-o",
-            index.to_str().unwrap(),
-        ],
-    );
-    assert!(again.status.success());
+    assert!(kernels(&dir, &field).status.success());
     let text = std::fs::read_to_string(&index).unwrap();
     assert_eq!(text.matches("cached = true").count(), 3, "{text}");
     let plain = dir.join("plain.bin");

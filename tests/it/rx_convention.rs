@@ -6,7 +6,7 @@
 //! conversion formula. Negative control: an eye built with the prescription at the cornea (the
 //! old convention, `--vertex-mm 0`), seen through the same lens at 12 mm, misses both bars.
 
-use crate::common::{json_ok, ocular_run, temp_dir};
+use crate::common::{eye_measure, eye_refract, json_ok, ocular_run, temp_dir};
 
 const CORRECTED_BAR_D: f64 = 0.12;
 const REFRACT_BAR_D: f64 = 0.06;
@@ -43,30 +43,17 @@ fn round_trip(dir: &std::path::Path, rx: (f64, f64, f64), extra: &[&str]) -> (f6
     args.extend(extra);
     let o = ocular_run(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let m = json_ok(&ocular_run(&[
-        "eye",
-        "measure",
+    let m = json_ok(&eye_measure(
         eye,
-        "--pupil-mm",
         "4",
-        "--wavelength-nm",
         "549",
-        "--correct",
-        &text,
-        "--json",
-    ]));
+        &["--correct", &text, "--json"],
+    ));
     let residual = ["m", "j0", "j45"]
         .iter()
         .map(|k| m["refraction"][k].as_f64().unwrap().abs())
         .fold(0.0, f64::max);
-    let r = json_ok(&ocular_run(&[
-        "eye",
-        "refract",
-        eye,
-        "--pupil-mm",
-        "4",
-        "--json",
-    ]));
+    let r = json_ok(&eye_refract(eye, "4", &["--json"]));
     assert_eq!(r["vertex_mm"].as_f64(), Some(12.0));
     let back = power_vector(
         r["sphere_d"].as_f64().unwrap(),
@@ -135,19 +122,12 @@ fn the_vertex_of_the_prescription_is_an_option_and_the_cornea_plane_misses_the_b
         eye.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let through = json_ok(&ocular_run(&[
-        "eye",
-        "measure",
+    let through = json_ok(&eye_measure(
         eye.to_str().unwrap(),
-        "--pupil-mm",
         "4",
-        "--wavelength-nm",
         "549",
-        "--correct",
-        "-6",
-        "--correct-contact",
-        "--json",
-    ]));
+        &["--correct", "-6", "--correct-contact", "--json"],
+    ));
     let left = through["refraction"]["m"].as_f64().unwrap();
     assert!(left.abs() < CORRECTED_BAR_D, "contact lens: M = {left}");
     // Bad vertex distances are refused with the option named.

@@ -45,6 +45,25 @@ pub fn ocular_run(args: &[&str]) -> Output {
     ocular().args(args).output().unwrap()
 }
 
+/// `ocular eye measure EYE --pupil-mm PUPIL --wavelength-nm WAVELENGTH EXTRA…` run to the end.
+pub fn eye_measure(eye: &str, pupil_mm: &str, wavelength_nm: &str, extra: &[&str]) -> Output {
+    ocular()
+        .args(["eye", "measure", eye, "--pupil-mm", pupil_mm])
+        .args(["--wavelength-nm", wavelength_nm])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+/// `ocular eye refract EYE --pupil-mm PUPIL EXTRA…` run to the end.
+pub fn eye_refract(eye: &str, pupil_mm: &str, extra: &[&str]) -> Output {
+    ocular()
+        .args(["eye", "refract", eye, "--pupil-mm", pupil_mm])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
 /// A fresh, empty folder for one test: `ocular-it-PID-MODULE-NAME` in the system's temporary
 /// folder, MODULE being the calling test's file, so the tests of every module can share one
 /// process (`name` need only be unique within a file).
