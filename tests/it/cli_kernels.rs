@@ -1,7 +1,7 @@
 //! `ocular kernels` end to end on a tiny grid: files written, the cache hit on a second run,
 //! clear exit-2 errors for bad options.
 
-use crate::common::{json_ok, ocular, ok, temp_dir};
+use crate::common::{json_ok, ocular, temp_dir};
 use ocular::psf::cache::read_grid;
 
 #[test]
@@ -108,31 +108,28 @@ fn kernels_report_the_missed_pupil_energy_per_column() {
         .arg(dir.join("k.bin"))
         .output()
         .unwrap();
-    ok(&out);
+    let json = json_ok(&out);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let report = &json["report"];
     assert_eq!(report["missed_energy_limit"].as_f64(), Some(1e-3));
     assert!(report["worst_missed_energy"].as_f64().unwrap() <= 1e-3);
     let column = &report["columns"][0];
-    let missed: Vec<f64> = column["missed_energy"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let per_channel = |key: &str| -> Vec<f64> {
+        column[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let missed = per_channel("missed_energy");
     assert_eq!(missed.len(), 3);
     assert!(
         missed.iter().all(|m| (0.0..=1e-3).contains(m)),
         "{missed:?}"
     );
     // where the expansion did not converge, the PSFs were computed by FFT
-    let beta: Vec<f64> = column["beta_truncation_error"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let beta = per_channel("beta_truncation_error");
     for (c, b) in beta.iter().enumerate() {
         if *b > 1e-3 {
             assert!(column["fft_psfs"][c].as_u64().unwrap() > 0, "{column}");

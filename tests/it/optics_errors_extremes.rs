@@ -10,6 +10,9 @@ fn base() -> PsfRequest {
     PsfRequest::new(vec![(3, 1, 0.1)], 5.0, 550.0, 0.5, 16)
 }
 
+/// One change that makes a valid request invalid.
+type Spoil = fn(&mut PsfRequest);
+
 fn err_of(req: PsfRequest) -> String {
     match compute_psf(&req) {
         Ok(_) => panic!("expected an error"),
@@ -48,34 +51,35 @@ fn invalid_requests_are_errors() {
     r.coefficients_um = vec![(3, 0, 0.1)];
     let e = err_of(r);
     assert!(e.contains("(3, 0)") && e.contains("n - |m| even"), "{e}");
-    let mut r = base();
-    r.coefficients_um = vec![(2, 4, 0.1)];
-    assert!(err_of(r).contains("unknown Zernike term"));
-    let mut r = base();
-    r.coefficients_um = vec![(40, 0, 0.1)];
-    assert!(err_of(r).contains("n <= 30"));
-    let mut r = base();
-    r.pitch_lambda_over_na = 0.0;
-    assert!(err_of(r).contains("pitch"));
-    let mut r = base();
-    r.size = 0;
-    assert!(err_of(r).contains("size"));
-    let mut r = base();
-    r.defocus_f = f64::NAN;
-    assert!(err_of(r).contains("defocus_f"));
-    let mut r = base();
-    r.defocus_f = 1e6;
-    assert!(err_of(r).contains("defocus_f"));
-    let mut r = base();
-    r.beta_tolerance = 0.0;
-    assert!(err_of(r).contains("beta_tolerance"));
-    let mut r = base();
-    r.stiles_crawford = Some(ocular::optics::beta::StilesCrawford { rho_per_mm2: -1.0 });
-    assert!(err_of(r).contains("stiles_crawford"));
-    // f from a huge c(2,0) is checked after it is folded in
-    let mut r = base();
-    r.coefficients_um = vec![(2, 0, 500.0)];
-    assert!(err_of(r).contains("total defocus f"));
+    let cases: [(Spoil, &str); 9] = [
+        (
+            |r| r.coefficients_um = vec![(2, 4, 0.1)],
+            "unknown Zernike term",
+        ),
+        (|r| r.coefficients_um = vec![(40, 0, 0.1)], "n <= 30"),
+        (|r| r.pitch_lambda_over_na = 0.0, "pitch"),
+        (|r| r.size = 0, "size"),
+        (|r| r.defocus_f = f64::NAN, "defocus_f"),
+        (|r| r.defocus_f = 1e6, "defocus_f"),
+        (|r| r.beta_tolerance = 0.0, "beta_tolerance"),
+        (
+            |r| {
+                r.stiles_crawford = Some(ocular::optics::beta::StilesCrawford { rho_per_mm2: -1.0 })
+            },
+            "stiles_crawford",
+        ),
+        // f from a huge c(2,0) is checked after it is folded in
+        (
+            |r| r.coefficients_um = vec![(2, 0, 500.0)],
+            "total defocus f",
+        ),
+    ];
+    for (spoil, want) in cases {
+        let mut r = base();
+        spoil(&mut r);
+        let e = err_of(r);
+        assert!(e.contains(want), "{want}: {e}");
+    }
 }
 
 #[test]

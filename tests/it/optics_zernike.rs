@@ -143,6 +143,13 @@ fn scatter(npts: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Every fitted coefficient within 1e-9 of the one sampled.
+fn assert_fits(fit: &[f64], sampled: &[f64]) {
+    for (a, b) in fit.iter().zip(sampled) {
+        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+    }
+}
+
 #[test]
 fn fit_from_wavefront_samples_reproduces_coefficients() {
     let order = 8;
@@ -151,10 +158,7 @@ fn fit_from_wavefront_samples_reproduces_coefficients() {
         .into_iter()
         .map(|(x, y)| (x, y, wavefront(&c, x, y)))
         .collect();
-    let fit = fit_wavefront(order, &samples).unwrap();
-    for (a, b) in fit.iter().zip(&c) {
-        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
-    }
+    assert_fits(&fit_wavefront(order, &samples).unwrap(), &c);
 }
 
 #[test]
@@ -169,10 +173,7 @@ fn fit_from_slopes_reproduces_coefficients() {
             (x, y, gx, gy)
         })
         .collect();
-    let fit = fit_slopes(order, &samples).unwrap();
-    for (a, b) in fit.iter().zip(&c) {
-        assert!((a - b).abs() < 1e-9, "{a} vs {b}");
-    }
+    assert_fits(&fit_slopes(order, &samples).unwrap(), &c);
 }
 
 #[test]
