@@ -37,6 +37,9 @@ pub struct MethodResult {
     pub flip_mean: f64,
     /// GPU time of all passes (splat only).
     pub gpu_ms: Option<f64>,
+    /// Pixel × fragment pairs inside a kernel's reach, per pixel of the frame (splat only): the
+    /// frame's cost read without a clock.
+    pub evaluations_per_pixel: Option<f64>,
     /// Depth layers the method saw.
     pub layers: u32,
     /// Quality over the occlusion-edge band (pixels within the local blur radius of a depth
@@ -160,6 +163,10 @@ impl Judge<'_> {
                 self.reference_seconds / frame.seconds.max(1e-12)
             },
             gpu_ms: frame.timings.as_ref().map(|t| t.total_ms()),
+            evaluations_per_pixel: frame
+                .stats
+                .as_ref()
+                .map(|s| s.kernel_evaluations as f64 / (self.width * self.height).max(1) as f64),
         };
         Ok(Row {
             result,
