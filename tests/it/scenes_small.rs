@@ -9,6 +9,7 @@
 
 use crate::common;
 use crate::common::{ocular, temp_dir};
+use std::path::Path;
 
 use ocular::psf::axes::{GridAxes, Screen};
 use ocular::psf::plan::plan_for_scene;
@@ -93,18 +94,21 @@ fn shipped_scenes_have_physical_depth_and_a_kernel_plan_at_every_size() {
     common::finish(ctx);
 }
 
-fn run(args: &[&str], cache: &std::path::Path) {
-    let out = ocular()
-        .args(args)
+/// `ocular COMMAND` of `scene` at `size` through the myopic eye into `out`, with `extra` and
+/// the kernel cache `cache`, which must succeed.
+fn run(command: &str, (scene, size): (&str, &str), out: &Path, extra: &[&str], cache: &Path) {
+    let mut cmd = ocular();
+    cmd.args([command, "--scene", scene, "--eye", "myopia", "--size", size])
+        .arg("-o")
+        .arg(out)
+        .args(extra)
         .arg("--cache")
-        .arg(cache)
-        .output()
-        .unwrap();
+        .arg(cache);
+    let output = cmd.output().unwrap();
     assert!(
-        out.status.success(),
-        "ocular {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
+        output.status.success(),
+        "{cmd:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
     );
 }
 
@@ -116,47 +120,23 @@ fn shipped_scenes_render_and_export_at_64x36_and_160x90() {
         let animated = Scene::load(name).unwrap().duration_s() > 0.0;
         for size in ["64x36", "160x90"] {
             let png = dir.join(format!("{name}-{size}.png"));
-            run(
-                &[
-                    "render",
-                    "--scene",
-                    name,
-                    "--eye",
-                    "myopia",
-                    "--size",
-                    size,
-                    "-o",
-                    png.to_str().unwrap(),
-                ],
-                &cache,
-            );
+            run("render", (name, size), &png, &[], &cache);
             assert!(png.is_file(), "{}", png.display());
             let frames = dir.join(format!("{name}-{size}"));
-            let mut args = vec![
-                "video",
-                "--scene",
-                name,
-                "--eye",
-                "myopia",
-                "--size",
-                size,
-                "-o",
-                frames.to_str().unwrap(),
-            ];
             // a still scene exports a focus sweep; the walk its own animation
-            if animated {
-                args.extend(["--frames", "0..3"]);
+            let extra: &[&str] = if animated {
+                &["--frames", "0..3"]
             } else {
-                args.extend([
+                &[
                     "--focus-sweep",
                     "0.25..6",
                     "--duration",
                     "0.1",
                     "--fps",
                     "30",
-                ]);
-            }
-            run(&args, &cache);
+                ]
+            };
+            run("video", (name, size), &frames, extra, &cache);
             let written = std::fs::read_dir(&frames)
                 .unwrap()
                 .filter(|e| {
