@@ -7,7 +7,7 @@
 //! `OCULAR_BENCH_THREADS=N` sets the worker count (default: all cores).
 
 use ocular::aberrations::preset;
-use ocular::eye::estimate::{estimate, Method, Settings};
+use ocular::eye::{estimate, Method, Settings};
 use std::sync::atomic::AtomicBool;
 
 fn main() {

@@ -7,9 +7,8 @@
 //! (estimated from the seed paper's measured keratoconus) and the hand-derived stand-ins of
 //! `eye::hand_made_eyes`.
 
-use ocular::eye::file::resolve;
-use ocular::optics::fft_psf::{fft_cost, psf_by_fft};
-use ocular::optics::psf::{psf_from_pupil, PsfRequest};
+use ocular::eye::resolve;
+use ocular::optics::{fft_cost, psf_by_fft, psf_from_pupil, PsfRequest};
 use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
 use ocular::psf::defocus::ColumnOptics;
 use ocular::psf::grid::{compute_grid, no_progress, GridReport};

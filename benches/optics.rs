@@ -3,8 +3,7 @@
 //! time of this thread (Linux /proc), which stays meaningful on a busy machine.
 
 use ocular::aberrations::preset;
-use ocular::optics::beta::beta_from_alpha;
-use ocular::optics::psf::{compute_psf, split_wavefront, PsfRequest};
+use ocular::optics::{beta_from_alpha, compute_psf, split_wavefront, PsfRequest};
 use std::time::Instant;
 
 /// CPU seconds of this thread (user + system), or None off Linux.

@@ -1,7 +1,7 @@
 //! Hand-made eyes, derived by hand rather than fitted to any measurement: Navarro's eye made
 //! myopic by a longer axis, and a keratoconus-like eye (steep, toric, irregular cornea). They
 //! stood in for the seed paper's estimated presets until eye estimation provided them, and are
-//! still accepted wherever an eye is named (`eye::file::resolve`, not listed as presets) and
+//! still accepted wherever an eye is named (`eye::resolve`, not listed as presets) and
 //! used by the kernel benchmarks and tests.
 
 use super::model::{ElevationTerm, Eye};

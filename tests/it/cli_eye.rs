@@ -35,7 +35,7 @@ fn estimate_from_prescription_writes_eye_json_and_plot() {
     ]);
     let text = ok(&out);
     assert!(text.contains("converged"), "{text}");
-    let file = ocular::eye::file::load(&eye).unwrap();
+    let file = ocular::eye::load(&eye).unwrap();
     let r = file.estimate.expect("estimate record");
     assert!(r.converged && r.all_in_bounds);
     assert!(r.rms_error_um < 0.02);
@@ -94,7 +94,7 @@ fn time_limit_writes_best_eye_marked_not_converged() {
     ]);
     let text = ok(&out);
     assert!(text.contains("NOT converged"), "{text}");
-    let file = ocular::eye::file::load(&eye).unwrap();
+    let file = ocular::eye::load(&eye).unwrap();
     assert!(!file.estimate.unwrap().converged);
     assert!(std::fs::read_to_string(&eye)
         .unwrap()
@@ -115,7 +115,7 @@ fn list_show_measure_draw() {
         assert!(list.contains(name), "{name} missing from {list}");
     }
     for name in ["healthy", "myopia", "astigmatism", "keratoconus"] {
-        let f = ocular::eye::file::preset(name).unwrap();
+        let f = ocular::eye::preset(name).unwrap();
         let r = f.estimate.expect("estimated preset");
         assert!(r.converged && r.all_in_bounds, "{name}");
         assert!(r.rms_error_um <= 0.02, "{name}: {}", r.rms_error_um);
@@ -238,7 +238,7 @@ fn ctrl_c_writes_best_eye_marked_not_converged() {
         text.contains("NOT converged (stopped: cancelled)"),
         "{text}"
     );
-    let r = ocular::eye::file::load(&eye).unwrap().estimate.unwrap();
+    let r = ocular::eye::load(&eye).unwrap().estimate.unwrap();
     assert!(!r.converged);
     assert_eq!(r.stop, "cancelled");
 }

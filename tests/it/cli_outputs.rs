@@ -408,7 +408,7 @@ fn cancelled_estimate(signal: &str, code: i32) {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(String::from_utf8_lossy(&out.stderr).contains(signal));
-    let r = ocular::eye::file::load(&eye).unwrap().estimate.unwrap();
+    let r = ocular::eye::load(&eye).unwrap().estimate.unwrap();
     assert!(!r.converged);
     assert_eq!(r.stop, "cancelled");
 }

@@ -239,7 +239,7 @@ fn focus_beyond_the_far_point_is_reported_where_the_eye_focuses() {
     let out = dir.join("out.png");
     // The myopia preset cannot relax to 5 m: its far point, by an independent paraxial
     // trace at the accommodation wavelength, is at −(paraxial refraction) dioptres.
-    let eye = ocular::eye::file::preset("myopia").unwrap().eye;
+    let eye = ocular::eye::preset("myopia").unwrap().eye;
     let sys = eye.system().unwrap();
     let far_point_d = -ocular::eye::paraxial(&sys, 549.0, 0.0).refraction_d;
     assert!(far_point_d > 5.0, "{far_point_d}");

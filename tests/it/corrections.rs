@@ -2,19 +2,16 @@
 //! refraction, each checked against an independent computation written here: thin-lens
 //! vergence formulas, a geometric spot diagram, the thin-lens IOL formula.
 
-use ocular::eye::accommodate::exerted_accommodation_d;
-use ocular::eye::age::{hofstetter_amplitude_d, HofstetterLine};
-use ocular::eye::correction::{Iol, Spectacle};
-use ocular::eye::media::{eye_index, Medium};
-use ocular::eye::refract::emmetropic_iol_power_d;
-use ocular::eye::refract::refract;
-use ocular::eye::trace::{trace_range, Ray};
-use ocular::eye::{file, focus_within_range, Eye, FocusLimit, Measurer};
+use ocular::eye::{
+    emmetropic_iol_power_d, exerted_accommodation_d, eye_index, focus_within_range,
+    hofstetter_amplitude_d, preset, refract, trace_range, Eye, FocusLimit, HofstetterLine, Iol,
+    Measurer, Medium, Ray, Spectacle,
+};
 
 const NM: f64 = 549.0;
 
 fn myopia() -> Eye {
-    file::preset("myopia").unwrap().eye
+    preset("myopia").unwrap().eye
 }
 
 fn far_refraction(eye: &Eye, pupil_mm: f64) -> (f64, f64, f64, f64) {
@@ -181,7 +178,7 @@ fn a_sixty_year_old_emmetrope_cannot_read_the_card_at_forty_centimetres_a_twenty
     // (logMAR 0.4, about N5) has strokes 10^0.4 = 2.5 arcmin wide.
     let stroke_arcmin = 10f64.powf(0.4);
     let pupil = 3.5; // the chart scene's Watson–Yellott pupil at these ages is 3.4–4.3 mm
-    let base = file::preset("healthy").unwrap().eye;
+    let base = preset("healthy").unwrap().eye;
     let blur_at = |age: Option<f64>| {
         let mut eye = base.clone();
         eye.accommodation_max_d = age.map(|a| hofstetter_amplitude_d(a, HofstetterLine::Mean));
@@ -218,7 +215,7 @@ fn a_sixty_year_old_emmetrope_cannot_read_the_card_at_forty_centimetres_a_twenty
 #[test]
 fn hofstetter_near_points_follow_the_amplitude() {
     // The near point (reached focus) of an emmetrope is its amplitude in dioptres.
-    let mut eye = file::preset("healthy").unwrap().eye;
+    let mut eye = preset("healthy").unwrap().eye;
     let (far, _, _, _) = far_refraction(&eye, 3.0);
     eye.accommodation_max_d = Some(3.0);
     let f = focus_within_range(&eye, Some(0.1), 3.0, NM, true).unwrap();
@@ -234,7 +231,7 @@ fn hofstetter_near_points_follow_the_amplitude() {
 
 #[test]
 fn the_emmetropic_iol_agrees_with_the_thin_lens_vergence_formula_and_does_not_accommodate() {
-    let eye = file::preset("healthy").unwrap().eye;
+    let eye = preset("healthy").unwrap().eye;
     let p = emmetropic_iol_power_d(&eye, 1.0, NM).unwrap();
     // Paraxial vergences through the cornea to the IOL plane, and what the retina needs.
     let c = &eye.cornea;
@@ -275,7 +272,7 @@ fn the_emmetropic_iol_agrees_with_the_thin_lens_vergence_formula_and_does_not_ac
 
 #[test]
 fn eye_files_carry_the_amplitude_and_the_correction_and_refuse_bad_values() {
-    let base = file::preset("healthy").unwrap().eye.to_toml_string();
+    let base = preset("healthy").unwrap().eye.to_toml_string();
     let text = format!(
         "accommodation_max_d = 0.5\n{base}\n[correction]\nsphere_d = 2.0\nvertex_mm = 12.0\n"
     );
@@ -303,9 +300,7 @@ fn eye_files_carry_the_amplitude_and_the_correction_and_refuse_bad_values() {
 
 #[test]
 fn an_ideal_lens_focuses_a_plane_wave_at_its_focal_length_with_equal_paths() {
-    use ocular::eye::media::Medium as M;
-    use ocular::eye::surface::Surface;
-    use ocular::eye::OpticalSystem;
+    use ocular::eye::{Medium as M, OpticalSystem, Surface};
     // +5 D toric lens (+5 along 30°, +3 across) in air: each principal meridian focuses at
     // 1/P, and by Fermat every ray of a meridian reaches its focal line with the same
     // optical path (the added phase and the bending are one consistent lens).

@@ -223,7 +223,7 @@ fn corneal_elevation_maps_into_the_wavefront() {
 
 #[test]
 fn cross_section_svg_draws_both_focus_states() {
-    let svg = ocular::eye::draw::cross_section_svg(&Eye::navarro(), &Default::default()).unwrap();
+    let svg = ocular::eye::cross_section_svg(&Eye::navarro(), &Default::default()).unwrap();
     assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
     assert!(svg.contains("focused at infinity") && svg.contains("focused at 0.2 m"));
     assert!(svg.matches("<polyline").count() >= 2 * (4 + 9));
@@ -232,7 +232,7 @@ fn cross_section_svg_draws_both_focus_states() {
 
 #[test]
 fn describe_and_coefficient_list() {
-    let text = ocular::eye::show::describe(&Eye::navarro(), 589.3, 4.0).unwrap();
+    let text = ocular::eye::describe(&Eye::navarro(), 589.3, 4.0).unwrap();
     println!("{text}");
     assert!(text.contains("power 60.41") && text.contains("anterior lens"));
     let m = measure(&Eye::navarro().system().unwrap(), 555.0, 4.0, None, 6).unwrap();

@@ -2,9 +2,9 @@
 //! prescription-only input, determinism, bounds, and an interrupted run.
 
 use ocular::aberrations::{preset, ZernikeSet};
-use ocular::eye::estimate::params::{prior_centre, Groups, ParamMap, ParamSpec};
-use ocular::eye::estimate::{estimate, Estimate, Method, Settings};
-use ocular::eye::{measure, Eye};
+use ocular::eye::{
+    estimate, measure, prior_centre, Estimate, Eye, Groups, Method, ParamMap, ParamSpec, Settings,
+};
 use ocular::optics::zernike::{osa_nm, Prescription};
 use std::sync::atomic::AtomicBool;
 

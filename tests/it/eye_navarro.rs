@@ -1,8 +1,9 @@
 //! The relaxed and accommodating Navarro eye against published figures.
 
-use ocular::eye::media::{eye_index, refractive_index, Medium};
-use ocular::eye::presets::{navarro_accommodated, NAVARRO_VITREOUS_MM};
-use ocular::eye::{measure, paraxial, Eye};
+use ocular::eye::{
+    eye_index, measure, navarro_accommodated, paraxial, refractive_index, Eye, Medium,
+    NAVARRO_VITREOUS_MM,
+};
 
 #[test]
 fn dispersion_matches_escudero_sanz_table() {

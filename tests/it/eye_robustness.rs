@@ -1,7 +1,9 @@
 //! Extreme but legal parameters give finite results; impossible ones give clear errors.
 
-use ocular::eye::lens::{lens_geometry, max_volume_mm3, LENS_THICKNESS_RATIO};
-use ocular::eye::{accommodate, measure, Eye, EyeError, Measurement};
+use ocular::eye::{
+    accommodate, lens_geometry, max_volume_mm3, measure, Eye, EyeError, Measurement,
+    LENS_THICKNESS_RATIO,
+};
 
 /// (name, setter, lower, upper) for every Table 1 parameter.
 type Setter = fn(&mut Eye, f64);

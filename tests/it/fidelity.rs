@@ -9,7 +9,7 @@
 
 use crate::common;
 
-use ocular::eye::file::resolve;
+use ocular::eye::resolve;
 use ocular::metrics::{psnr, ImageView};
 use ocular::psf::axes::Screen;
 use ocular::render::frame::{

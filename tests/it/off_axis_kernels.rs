@@ -5,8 +5,7 @@
 //! measured wavefront plus the object's vergence (|q|²·ΔD/2). Negative control: the same
 //! coefficients treated as a circular pupil (the on-axis pipeline) miss the ratio.
 
-use ocular::eye::field::measure_field;
-use ocular::eye::Eye;
+use ocular::eye::{measure_field, Eye};
 use ocular::optics::zernike::basis_values;
 use ocular::psf::axes::{KernelSettings, Screen};
 use ocular::psf::field::{field_column, frame_half_field_deg, FieldAxes};
@@ -187,5 +186,5 @@ fn field_plan_covers_the_frame_with_the_coarsest_passing_steps() {
         *wide.axes.h_deg.last().unwrap(),
         *wide.axes.v_deg.last().unwrap(),
     ];
-    assert!(ocular::eye::field::eccentricity_deg(corner) <= 60.0);
+    assert!(ocular::eye::eccentricity_deg(corner) <= 60.0);
 }

@@ -13,8 +13,7 @@
 //! the skewness of the traced spot along the retina's radius against that of ocular's kernel
 //! along screen x (the eye's inversion keeps radial directions radial).
 
-use ocular::eye::field::measure_field;
-use ocular::eye::{Eye, Retina};
+use ocular::eye::{measure_field, Eye, Retina};
 
 const WAVELENGTH_NM: f64 = 589.3;
 const PUPIL_MM: f64 = 4.0;

@@ -10,7 +10,7 @@ use crate::common;
 use common::frames::{frame_renderer, splat_and_truth};
 use common::pixels::max_rgb_difference;
 
-use ocular::eye::file::resolve;
+use ocular::eye::resolve;
 use ocular::psf::axes::Screen;
 use ocular::render::frame::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,

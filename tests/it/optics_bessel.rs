@@ -1,7 +1,7 @@
 //! Bessel functions against independent values: power series, asymptotic forms, known
 //! values and identities, at orders up to 3000+ and arguments up to 5000+.
 
-use ocular::optics::bessel::*;
+use ocular::optics::{bessel_j, bessel_j_sequence, spherical_j, spherical_j_sequence};
 use std::f64::consts::PI;
 
 /// Power series Σ_k (−1)^k (x/2)^{2k+n}/(k!(n+k)!) — accurate for moderate x.

@@ -2,8 +2,8 @@
 //! apodisation.
 
 use num_complex::Complex64;
-use ocular::optics::beta::{beta_from_alpha, StilesCrawford};
 use ocular::optics::zernike::{num_terms, osa_index};
+use ocular::optics::{beta_from_alpha, StilesCrawford};
 use std::f64::consts::PI;
 
 fn alpha(order: u32, terms: &[(u32, i32, f64)]) -> Vec<f64> {

@@ -2,10 +2,10 @@
 //! series and an independent Gauss–Legendre quadrature over a wide (n, m, r, f) grid.
 
 use num_complex::Complex64;
-use ocular::optics::enz::{
+use ocular::optics::zernike::{num_terms, osa_nm};
+use ocular::optics::{
     quadrature_nodes, vnm, vnm_power_series, vnm_quadrature, vnm_quadrature_all, VTable,
 };
-use ocular::optics::zernike::{num_terms, osa_nm};
 use std::f64::consts::PI;
 
 #[test]
@@ -26,7 +26,7 @@ fn closed_forms_v00() {
         let exact = if r == 0.0 {
             0.5
         } else {
-            ocular::optics::bessel::bessel_j(1, v) / v
+            ocular::optics::bessel_j(1, v) / v
         };
         assert!((vnm(0, 0, r, 0.0).re - exact).abs() < 1e-13, "r={r}");
         assert!(vnm(0, 0, r, 0.0).im.abs() < 1e-15);
@@ -106,7 +106,7 @@ fn single_quadrature_agrees() {
 #[test]
 fn table_interpolation_accuracy() {
     let f = 60.0;
-    let step = ocular::optics::enz::interpolation_step(1e-6);
+    let step = ocular::optics::interpolation_step(1e-6);
     let t = VTable::new(8, f, 40.0, step).unwrap();
     let mut worst: f64 = 0.0;
     for i in 0..400 {

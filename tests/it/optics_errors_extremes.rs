@@ -2,9 +2,7 @@
 //! never yields NaN or Inf.
 
 use ocular::aberrations::preset;
-use ocular::optics::enz::{try_vnm, vnm};
-use ocular::optics::psf::{compute_psf, defocus_f_from_dioptres, PsfRequest};
-use ocular::optics::OpticsError;
+use ocular::optics::{compute_psf, defocus_f_from_dioptres, try_vnm, vnm, OpticsError, PsfRequest};
 
 fn base() -> PsfRequest {
     PsfRequest::new(vec![(3, 1, 0.1)], 5.0, 550.0, 0.5, 16)
@@ -63,9 +61,7 @@ fn invalid_requests_are_errors() {
         (|r| r.defocus_f = 1e6, "defocus_f"),
         (|r| r.beta_tolerance = 0.0, "beta_tolerance"),
         (
-            |r| {
-                r.stiles_crawford = Some(ocular::optics::beta::StilesCrawford { rho_per_mm2: -1.0 })
-            },
+            |r| r.stiles_crawford = Some(ocular::optics::StilesCrawford { rho_per_mm2: -1.0 }),
             "stiles_crawford",
         ),
         // f from a huge c(2,0) is checked after it is folded in
@@ -141,7 +137,7 @@ fn extreme_valid_inputs_stay_finite() {
         .unwrap_err()
         .to_string()
         .contains("grid extent"));
-    assert!(ocular::optics::enz::VTable::new(20, 10.0, 20000.0, 1e-4).is_err());
+    assert!(ocular::optics::VTable::new(20, 10.0, 20000.0, 1e-4).is_err());
     // the smallest allowed cap still works
     let mut r = PsfRequest::new(vec![(3, 1, 0.1)], 5.0, 550.0, 0.5, 8);
     r.max_degree = 1;

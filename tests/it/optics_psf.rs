@@ -3,11 +3,12 @@
 
 use num_complex::Complex64;
 use ocular::aberrations::preset;
-use ocular::optics::bessel::{bessel_j, bessel_j_sequence};
-use ocular::optics::psf::{compute_psf, defocus_f_from_dioptres, Psf, PsfRequest};
-use ocular::optics::quadrature::gauss_legendre_01;
 use ocular::optics::zernike::wavefront;
 use ocular::optics::zernike::{num_terms, osa_index};
+use ocular::optics::{
+    bessel_j, bessel_j_sequence, compute_psf, defocus_f_from_dioptres, gauss_legendre_01, Psf,
+    PsfRequest,
+};
 use std::f64::consts::PI;
 
 /// Direct evaluation of U(x, y) = (1/π)∫∫ P e^{ifρ²} e^{i2π(xρcosθ + yρsinθ)} ρ dρ dθ with the
@@ -429,9 +430,7 @@ fn behind_and_in_front_of_focus_differ_with_spherical_aberration() {
 fn radial_interpolation_holds_1e_6() {
     // A tilt forces the tabulated path (no symmetric grid); compare every pixel with the exact
     // point evaluation of the same field. Intensity error ≈ 2|U|·field error ≤ ~2e-6 of peak.
-    use ocular::optics::amplitude::RadialAmplitude;
-    use ocular::optics::beta::beta_from_alpha;
-    use ocular::optics::psf::split_wavefront;
+    use ocular::optics::{beta_from_alpha, split_wavefront, RadialAmplitude};
     for (f, pitch) in [(0.0, 0.3), (60.0, 0.9), (-300.0, 3.7)] {
         let coeffs = vec![(1, 1, 0.3), (3, -1, 0.15), (4, 0, 0.1), (3, 3, 0.05)];
         let mut req = request(coeffs.clone(), 5.0, 550.0, f, pitch);
@@ -469,9 +468,7 @@ fn radial_interpolation_holds_1e_6() {
 fn centred_grids_match_pointwise_field() {
     // Without tilt the grid is filled four mirror images at a time (exact radii or table);
     // every pixel must still equal the field evaluated at that point, for even and odd sizes.
-    use ocular::optics::amplitude::RadialAmplitude;
-    use ocular::optics::beta::beta_from_alpha;
-    use ocular::optics::psf::split_wavefront;
+    use ocular::optics::{beta_from_alpha, split_wavefront, RadialAmplitude};
     let coeffs = vec![
         (2, -2, 0.2),
         (3, 1, 0.15),
@@ -506,7 +503,7 @@ fn centred_grids_match_pointwise_field() {
 
 #[test]
 fn through_focus_reuses_one_pupil_expansion() {
-    use ocular::optics::psf::{expand_pupil, psf_from_pupil};
+    use ocular::optics::{expand_pupil, psf_from_pupil};
     let set = preset("myopia").unwrap();
     let mut req = PsfRequest::new(
         vec![(2, 0, 5.4127), (4, 0, 0.04), (3, -1, 0.04)],

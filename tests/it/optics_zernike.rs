@@ -1,6 +1,6 @@
 //! Zernike algebra: indices, orthonormality, fits, pupil rescaling, prescriptions.
 
-use ocular::optics::quadrature::gauss_legendre_01;
+use ocular::optics::gauss_legendre_01;
 use ocular::optics::zernike::*;
 use std::f64::consts::PI;
 

@@ -8,7 +8,7 @@
 use crate::common;
 use common::frames::{frame_renderer, splat_and_truth};
 
-use ocular::eye::file::resolve;
+use ocular::eye::resolve;
 use ocular::psf::axes::Screen;
 use ocular::psf::exact::ExactEye;
 use ocular::render::frame::{dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions};

@@ -2,9 +2,8 @@
 //! parameter against a direct measurement, focus behaviour of a healthy eye, planning and
 //! extreme inputs. Small grids only: each test runs in seconds in release mode.
 
-use ocular::eye::trace::{trace_range, Ray};
-use ocular::eye::{accommodate, measure, Eye};
-use ocular::optics::psf::defocus_f_from_c20;
+use ocular::eye::{accommodate, measure, trace_range, Eye, Ray};
+use ocular::optics::defocus_f_from_c20;
 use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
 use ocular::psf::defocus::{ChannelOptics, ColumnOptics};
 use ocular::psf::exact::ExactEye;
@@ -224,10 +223,7 @@ fn nearer_and_farther_than_focus_differ_once_the_pupil_is_asymmetric() {
 #[test]
 fn defocus_parameter_matches_a_direct_measurement() {
     let settings = KernelSettings::default();
-    for eye in [
-        Eye::navarro(),
-        ocular::eye::hand_made_eyes::keratoconus_like(),
-    ] {
+    for eye in [Eye::navarro(), ocular::eye::keratoconus_like()] {
         let pupil = 5.0;
         // within reach of both (the keratoconus-like eye is about 3 D myopic)
         let focus_d = 5.0;
@@ -439,7 +435,7 @@ fn extreme_settings_give_finite_kernels_or_clear_errors() {
         ("focus 0.1 m", Eye::navarro(), 4.0, 10.0, WL),
         (
             "-10 D eye",
-            ocular::eye::hand_made_eyes::hand_made_eye("myopia10-like").unwrap(),
+            ocular::eye::hand_made_eye("myopia10-like").unwrap(),
             4.0,
             0.0,
             WL,

@@ -15,7 +15,7 @@
 
 use num_complex::Complex64;
 use ocular::eye::Eye;
-use ocular::optics::quadrature::gauss_legendre_01;
+use ocular::optics::gauss_legendre_01;
 use ocular::optics::zernike::{wavefront, wavefront_gradient};
 use ocular::psf::axes::{GridAxes, KernelSettings, MethodChoice, Screen};
 use ocular::psf::defocus::ChannelOptics;
@@ -30,7 +30,7 @@ use std::f64::consts::PI;
 const WL: [f64; 3] = [612.0, 549.0, 464.0];
 
 fn eye(name: &str) -> Eye {
-    ocular::eye::file::resolve(name).expect("shipped eye").eye
+    ocular::eye::resolve(name).expect("shipped eye").eye
 }
 
 /// Gauss–Legendre nodes and weights on [a, b].
@@ -457,7 +457,7 @@ fn navarro_near_focus_at_6_mm() {
 /// keratoconus eye model vignettes an 8 mm pupil when focused: it is held to 7.5 mm.)
 #[test]
 fn every_shipped_eye_keeps_its_pupil_energy() {
-    for name in ocular::eye::file::preset_names() {
+    for name in ocular::eye::preset_names() {
         let largest = if name == "keratoconus" { 7.5 } else { 8.0 };
         let axes = GridAxes {
             objects: DioptreAxis::spanning(0.5, 3.0, 2),

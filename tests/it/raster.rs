@@ -478,7 +478,7 @@ color = [0.5, 1.0, 2.0]
 /// follow; its depth (the object's distance) does not change.
 #[test]
 fn spectacle_magnification_scales_the_view_per_meridian() {
-    use ocular::eye::correction::Spectacle;
+    use ocular::eye::Spectacle;
     let ctx = common::gpu();
     let mut raster = Rasterizer::new(&ctx).unwrap();
     let (w, h) = (160u32, 90u32);

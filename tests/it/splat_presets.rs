@@ -7,7 +7,7 @@
 use crate::common;
 use common::frames::{frame_renderer, splat_and_truth};
 
-use ocular::eye::file::resolve;
+use ocular::eye::resolve;
 use ocular::metrics::{psnr, ssim, ImageView};
 use ocular::psf::axes::Screen;
 use ocular::render::frame::{

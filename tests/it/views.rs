@@ -5,13 +5,12 @@
 use crate::common;
 use crate::common::scenes::square_scene;
 
-use ocular::eye::file::resolve;
+use ocular::eye::resolve;
 use ocular::metrics::{psnr, ImageView};
 use ocular::psf::axes::{KernelSettings, Screen, DEFAULT_WAVELENGTHS_NM};
 use ocular::psf::defocus::ColumnOptics;
 use ocular::psf::exact::ExactEye;
-use ocular::render::views;
-use ocular::render::Rasterizer;
+use ocular::render::{views, Rasterizer};
 use ocular::scene::Scene;
 
 /// Energy, centroid (x, y) and variance (x, y) of one channel, pixel centres at integers.
