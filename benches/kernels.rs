@@ -9,10 +9,10 @@
 
 use ocular::eye::resolve;
 use ocular::optics::{fft_cost, psf_by_fft, psf_from_pupil, PsfRequest};
-use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
-use ocular::psf::defocus::ColumnOptics;
-use ocular::psf::grid::{compute_grid, no_progress, GridReport};
-use ocular::psf::project::{enz_cost, psf_grid};
+use ocular::psf::{
+    compute_grid, enz_cost, no_progress, psf_grid, ColumnOptics, GridAxes, GridReport,
+    KernelSettings, Screen,
+};
 use std::time::Instant;
 
 fn screen() -> Screen {

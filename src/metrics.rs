@@ -11,6 +11,9 @@
 //! An image with a side under 11 pixels has no valid region for that window: SSIM is then
 //! computed with the largest odd window that fits (σ scaled with it), and `Ssim::window_px`
 //! says which, so a caller can report it rather than print a number on another scale.
+//!
+//! The items defined here and the [`flip`] module are the public surface; `flip` stays public
+//! as the FLIP metric's own namespace, with its own re-exported surface.
 
 pub mod flip;
 

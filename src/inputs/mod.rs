@@ -1,18 +1,22 @@
 //! Colour and depth from files other tools wrote (Blender and other renderers, cameras,
 //! image editors): which data to take, how to read it as linear cd/m² and metres, and what to
 //! refuse. Everything a file input goes through before it reaches a renderer is here, once.
+//!
+//! The submodules are private: [`load`], its types and the `pub use` items below are the
+//! module's public surface.
 
-pub mod depth;
-pub mod exr;
-pub mod layered;
-pub mod picture;
+pub(crate) mod depth;
+pub(crate) mod exr;
+pub(crate) mod layered;
+pub(crate) mod picture;
 
 use std::path::{Path, PathBuf};
 
 use crate::image_types::ImageRgba;
 use crate::{Error, Result};
 
-pub use depth::DepthReport;
+// Depth: raw samples to metres, and what that did.
+pub use depth::{apply, DepthReport};
 
 /// What to read and how.
 #[derive(Clone, Debug)]

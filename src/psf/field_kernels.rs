@@ -120,7 +120,6 @@ pub struct FieldKernelsOutcome {
     /// Per node, when computed now (empty when every node came from the cache).
     pub reports: Vec<GridReport>,
     pub cache: CacheOutcome,
-    pub seconds: f64,
 }
 
 /// The cache key of a whole field set (its nodes' keys, in order).
@@ -168,7 +167,6 @@ pub fn compute_kernel_field(
     cache_dir: Option<&Path>,
     progress: Progress,
 ) -> Result<FieldKernelsOutcome> {
-    let started = Instant::now();
     let nodes = field.nodes();
     let set_key = field_set_key(eye, axes, screen, settings, field);
     if let Some(dir) = cache_dir {
@@ -182,7 +180,6 @@ pub fn compute_kernel_field(
                     field: kf,
                     reports: Vec::new(),
                     cache: CacheOutcome::Hit(cache_path(dir, &node_key(&set_key, 0))),
-                    seconds: started.elapsed().as_secs_f64(),
                 });
             }
         }
@@ -250,7 +247,6 @@ pub fn compute_kernel_field(
         field: kf,
         reports,
         cache,
-        seconds: started.elapsed().as_secs_f64(),
     })
 }
 

@@ -13,20 +13,43 @@
 //!   over those directions.
 //! - [`cache`]: grid files and the on-disk cache; [`preview`]: contact sheet and size plot.
 //! - [`kernels`]: the contract with the GPU runtime.
+//!
+//! The submodules are private: the `pub use` items below are the module's public surface.
 
-pub mod axes;
-pub mod cache;
-pub mod defocus;
-pub mod exact;
-pub mod field;
-pub mod field_kernels;
-pub mod field_plan;
-pub mod field_psf;
-pub mod field_shape;
-pub mod grid;
-pub mod integrate;
-pub mod kernels;
-pub mod plan;
-pub mod preview;
-pub mod project;
-pub mod request;
+pub(crate) mod axes;
+pub(crate) mod cache;
+pub(crate) mod defocus;
+pub(crate) mod exact;
+pub(crate) mod field;
+pub(crate) mod field_kernels;
+pub(crate) mod field_plan;
+pub(crate) mod field_psf;
+pub(crate) mod field_shape;
+pub(crate) mod grid;
+pub(crate) mod integrate;
+pub(crate) mod kernels;
+pub(crate) mod plan;
+pub(crate) mod preview;
+pub(crate) mod project;
+pub(crate) mod request;
+
+// The grid's axes, the screen and the numerical settings.
+pub use axes::{linspace, GridAxes, KernelSettings, MethodChoice, Screen, DEFAULT_WAVELENGTHS_NM};
+// An eye's optics per channel and object distance, and the exact eye of the ground truth.
+pub use defocus::{ChannelOptics, ColumnOptics};
+pub use exact::ExactEye;
+// PSF sampling, cropping and its cost.
+pub use field_psf::cropped_psf;
+pub use project::{cropped_psf_at_f, enz_cost, psf_grid, CroppedPsf};
+// Kernel grids: their computation, what a scene needs, and the contract with the GPU runtime.
+pub use grid::{compute_grid, kernels_from_columns, no_progress, GridReport};
+pub use kernels::{
+    kernel_side, level_block_radius, level_count, level_of_radius, level_radius_px, DioptreAxis,
+    KernelGrid, KernelSet,
+};
+pub use plan::{plan_for_scene, SceneNeeds};
+// Kernels across the visual field.
+pub use field::{field_column, frame_half_field_deg, FieldAxes};
+pub use field_plan::{plan_field_axes, Probe, FIELD_TOLERANCE_UM};
+// Grid files and the on-disk cache.
+pub use cache::{cache_path, cached, grid_key, read_grid, write_grid, CacheOutcome};

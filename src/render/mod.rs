@@ -1,19 +1,31 @@
 //! Rendering: joins scenes, the eye's kernels (`psf`) and the GPU layer (`gpu`). Each GPU pass
 //! is one Rust file plus GLSL files of the same stem under glsl/render/.
+//!
+//! The `pub use` items below are the module's public surface. Four submodules stay public:
+//! [`splat`], the tiled splatting renderer, and [`reference`], [`slices`] and [`views`], three
+//! other renderers whose entry point is each called `render` (re-exporting them would collide).
 
-pub mod blend;
-pub mod edge_band;
-pub mod focus;
-pub mod frame;
-pub mod frame_plan;
-pub mod judge;
-pub mod projection;
-pub mod raster;
+pub(crate) mod blend;
+pub(crate) mod edge_band;
+pub(crate) mod focus;
+pub(crate) mod frame;
+pub(crate) mod frame_plan;
+pub(crate) mod judge;
+pub(crate) mod projection;
+pub(crate) mod raster;
 pub mod reference;
-pub mod scene_frame;
+pub(crate) mod scene_frame;
 pub mod slices;
 pub mod splat;
-pub mod timeline;
+pub(crate) mod timeline;
 pub mod views;
 
+// Rasterising a scene into colour and depth.
 pub use raster::{Frame, Rasterizer, MSAA_SAMPLES};
+// How layers of fragments are blended.
+pub use blend::{BlendMode, BlendSettings, DEFAULT_GROUP_TOLERANCE_D};
+// One frame from a scene and an eye: its kernels and its renderer.
+pub use frame::{
+    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
+    PreparedKernels,
+};

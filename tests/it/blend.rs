@@ -8,12 +8,10 @@ use crate::common;
 
 use common::pixels::opaque_pixels;
 use common::synthetic::{ExactSynthetic, SyntheticEye, NO_MERGE};
-use ocular::psf::kernels::{
-    kernel_side, level_block_radius, level_of_radius, DioptreAxis, KernelGrid,
-};
-use ocular::render::blend::{BlendMode, BlendSettings};
+use ocular::psf::{kernel_side, level_block_radius, level_of_radius, DioptreAxis, KernelGrid};
 use ocular::render::reference::{self, ExactKernels};
 use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
+use ocular::render::{BlendMode, BlendSettings};
 
 struct Frame {
     w: usize,

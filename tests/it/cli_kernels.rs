@@ -2,7 +2,7 @@
 //! clear exit-2 errors for bad options.
 
 use crate::common::{json_ok, ocular, temp_dir};
-use ocular::psf::cache::read_grid;
+use ocular::psf::read_grid;
 
 #[test]
 fn kernels_writes_grid_pictures_and_uses_the_cache() {

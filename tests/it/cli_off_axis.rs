@@ -105,7 +105,7 @@ fn kernels(dir: &std::path::Path, extra: &[&str]) -> Output {
 /// in-focus kernel is larger (oblique astigmatism and coma).
 #[test]
 fn kernels_over_the_field_are_written_and_cached_per_direction() {
-    use ocular::psf::cache::read_grid;
+    use ocular::psf::read_grid;
     let dir = temp_dir("field");
     let index = dir.join("field.toml");
     let field = [
@@ -132,7 +132,7 @@ fn kernels_over_the_field_are_written_and_cached_per_direction() {
     assert!(centre.sets[0].texels == on_axis.sets[0].texels);
     let side = read_grid(&dir.join("field.h2.v0.bin"), None).unwrap();
     let mirror = read_grid(&dir.join("field.h0.v0.bin"), None).unwrap();
-    let r = |g: &ocular::psf::kernels::KernelGrid| g.sets[0].radius_px[0][1];
+    let r = |g: &ocular::psf::KernelGrid| g.sets[0].radius_px[0][1];
     assert!(
         r(&side) > r(&centre) + 0.5,
         "{} vs {}",

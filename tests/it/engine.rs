@@ -8,12 +8,11 @@ use crate::common;
 
 use common::pixels::{max_rgb_difference, opaque_pixels};
 use common::synthetic::SyntheticEye;
-use ocular::psf::kernels::{DioptreAxis, KernelGrid};
-use ocular::render::blend::{BlendMode, BlendSettings};
+use ocular::psf::{DioptreAxis, KernelGrid};
 use ocular::render::splat::{
     ConvolveWalk, FrameInput, MergeSettings, SplatOutput, SplatSettings, Splatter, ViewState,
 };
-use ocular::render::Rasterizer;
+use ocular::render::{BlendMode, BlendSettings, Rasterizer};
 use ocular::scene::{FrameState, Scene};
 
 struct Frame {

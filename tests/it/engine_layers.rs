@@ -9,10 +9,9 @@ use crate::common;
 
 use common::pixels::{hidden_layers, max_rgb_difference};
 use common::synthetic::SyntheticEye;
-use ocular::psf::kernels::{DioptreAxis, KernelGrid};
-use ocular::render::blend::BlendSettings;
+use ocular::psf::{DioptreAxis, KernelGrid};
 use ocular::render::splat::{FrameInput, SplatOutput, SplatSettings, Splatter, ViewState};
-use ocular::render::{Frame, Rasterizer};
+use ocular::render::{BlendSettings, Frame, Rasterizer};
 use ocular::scene::{FrameState, Scene};
 
 const W: u32 = 160;

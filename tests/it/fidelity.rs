@@ -11,18 +11,18 @@ use crate::common;
 
 use ocular::eye::resolve;
 use ocular::metrics::{psnr, ImageView};
-use ocular::psf::axes::Screen;
-use ocular::render::frame::{
+use ocular::psf::Screen;
+use ocular::render::splat::{FrameInput, HiddenLayer, SplatSettings};
+use ocular::render::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
 };
-use ocular::render::splat::{FrameInput, HiddenLayer, SplatSettings};
 
 /// The seed paper's blend: every fragment composited front to back, the output divided by
 /// the coverage (the negative control for the light behind a point).
 fn paper_blend() -> SplatSettings {
     SplatSettings {
-        blend: ocular::render::blend::BlendSettings {
-            mode: ocular::render::blend::BlendMode::PerFragment,
+        blend: ocular::render::BlendSettings {
+            mode: ocular::render::BlendMode::PerFragment,
             ..Default::default()
         },
         ..SplatSettings::default()
@@ -55,7 +55,7 @@ fn render(
         state,
         splat,
         with_reference,
-        ocular::psf::axes::GridAxes::default(),
+        ocular::psf::GridAxes::default(),
     )
 }
 
@@ -67,7 +67,7 @@ fn render_on(
     state: EyeState,
     splat: SplatSettings,
     with_reference: bool,
-    axes: ocular::psf::axes::GridAxes,
+    axes: ocular::psf::GridAxes,
 ) -> Rendered {
     let options = KernelOptions {
         cache_dir: cache(),
@@ -367,7 +367,7 @@ fn spots_and_paper_control(
         with_reference,
     );
     let paper = SplatSettings {
-        blend: ocular::render::blend::BlendSettings::paper(),
+        blend: ocular::render::BlendSettings::paper(),
         ..SplatSettings::default()
     };
     let control = render(ctx, "healthy", input, state, paper, false).splat;
@@ -462,7 +462,7 @@ fn case3_truth(x: usize, wall_row: &[f64]) -> f64 {
 
 #[test]
 fn case3_an_in_focus_wall_past_a_near_edge() {
-    use ocular::psf::exact::ExactEye;
+    use ocular::psf::ExactEye;
     use ocular::render::reference::ExactKernels;
     let ctx = common::gpu();
     let (w, h, fov) = C3;
@@ -621,7 +621,7 @@ fn zernike(j: usize, rho: f64, phi: f64) -> f64 {
 /// (`dv` = V_focus − V_object), at `focal_px` pixels per radian: an `n`-point transform with
 /// `s` (odd) samples per pixel. Normalised to sum 1 over the kernel.
 fn wave_kernel(
-    ch: &ocular::psf::defocus::ChannelOptics,
+    ch: &ocular::psf::ChannelOptics,
     dv: f64,
     focal_px: f64,
     (n, s, half): (usize, usize, usize),
@@ -701,13 +701,13 @@ fn wave_kernel(
 }
 
 /// The focused healthy eye's channels (its Zernike coefficients per wavelength).
-fn healthy_column(pupil_mm: f64, focus_d: f64) -> ocular::psf::defocus::ColumnOptics {
-    ocular::psf::defocus::ColumnOptics::new(
+fn healthy_column(pupil_mm: f64, focus_d: f64) -> ocular::psf::ColumnOptics {
+    ocular::psf::ColumnOptics::new(
         &resolve("healthy").unwrap().eye,
         pupil_mm,
         focus_d,
-        ocular::psf::axes::DEFAULT_WAVELENGTHS_NM,
-        &ocular::psf::axes::KernelSettings::default(),
+        ocular::psf::DEFAULT_WAVELENGTHS_NM,
+        &ocular::psf::KernelSettings::default(),
     )
     .unwrap()
 }
@@ -789,12 +789,12 @@ fn case7_small_blur_sweep_against_the_wave_optics_truth() {
     );
     // The default object axis (1/16 D steps from 0 D), one of 0.025 D steps from 0, and the
     // seed paper's (0.25 D steps from 0.125 D, the default before), kept as a control.
-    let fine = ocular::psf::axes::GridAxes {
-        objects: ocular::psf::kernels::DioptreAxis::spanning(0.0, 10.0, 401),
+    let fine = ocular::psf::GridAxes {
+        objects: ocular::psf::DioptreAxis::spanning(0.0, 10.0, 401),
         ..Default::default()
     };
-    let paper = ocular::psf::axes::GridAxes {
-        objects: ocular::psf::kernels::DioptreAxis::spanning(0.125, 10.125, 41),
+    let paper = ocular::psf::GridAxes {
+        objects: ocular::psf::DioptreAxis::spanning(0.125, 10.125, 41),
         ..Default::default()
     };
     // (defocus, bar on the default axis, bar on the fine axis): near the measured values. The

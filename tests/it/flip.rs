@@ -161,7 +161,7 @@ fn maps_match_the_reference_implementation_on_float_images() {
 fn hdr_exposure_range_matches_the_reference_implementation() {
     for case in cases().iter().filter(|c| c.hdr) {
         let r = ImageView::new(case.width, case.height, &case.reference);
-        let got = flip::hdr::exposure_range(r, &case.settings).expect("range");
+        let got = flip::exposure_range(r, &case.settings).expect("range");
         let (start, stop, count) = case.range.unwrap();
         assert!((got.start - start).abs() < 1e-4, "{}: {got:?}", case.name);
         assert!((got.stop - stop).abs() < 1e-4, "{}: {got:?}", case.name);
@@ -190,7 +190,7 @@ fn hdr_exposure_range_follows_its_definition() {
             }
         }
         let x = 0.5 * (lo + hi);
-        let range = flip::hdr::exposure_range(
+        let range = flip::exposure_range(
             view,
             &HdrSettings {
                 tone_mapper: tm,
@@ -207,9 +207,7 @@ fn hdr_exposure_range_follows_its_definition() {
     }
     // an all-black reference has no automatic range: an error, not an infinite loop
     let black = vec![[0.0f32, 0.0, 0.0, 1.0]; 4];
-    assert!(
-        flip::hdr::exposure_range(ImageView::new(2, 2, &black), &HdrSettings::default()).is_err()
-    );
+    assert!(flip::exposure_range(ImageView::new(2, 2, &black), &HdrSettings::default()).is_err());
 }
 
 /// 8-bit sRGB test patterns: edges, fine text-like detail, noise, a colour change.

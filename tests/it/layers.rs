@@ -9,10 +9,9 @@ use std::path::Path;
 
 use common::pixels::{hidden_layers, max_rgb_difference};
 use common::synthetic::SyntheticEye;
-use ocular::psf::kernels::DioptreAxis;
-use ocular::render::blend::DEFAULT_GROUP_TOLERANCE_D;
+use ocular::psf::DioptreAxis;
 use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
-use ocular::render::{Frame, Rasterizer};
+use ocular::render::{Frame, Rasterizer, DEFAULT_GROUP_TOLERANCE_D};
 use ocular::scene::Scene;
 
 const W: u32 = 160;

@@ -7,9 +7,9 @@
 
 use ocular::eye::{measure_field, Eye};
 use ocular::optics::zernike::basis_values;
-use ocular::psf::axes::{KernelSettings, Screen};
-use ocular::psf::field::{field_column, frame_half_field_deg, FieldAxes};
-use ocular::psf::field_psf::cropped_psf;
+use ocular::psf::{
+    cropped_psf, field_column, frame_half_field_deg, FieldAxes, KernelSettings, Screen,
+};
 
 /// Variances (rad²) of the ray angle along x and y over the ellipse with semi-axes `a`
 /// (mm), for the wavefront Σ c_j Z_j(x/a₀, y/a₁) + ΔD·|q|²/2 (µm, q in mm).
@@ -139,7 +139,7 @@ fn field_axes_parse_and_frame_range() {
 /// node fewer per axis fails it (the count is the coarsest that passes).
 #[test]
 fn field_plan_covers_the_frame_with_the_coarsest_passing_steps() {
-    use ocular::psf::field_plan::{plan_field_axes, Probe, FIELD_TOLERANCE_UM};
+    use ocular::psf::{plan_field_axes, Probe, FIELD_TOLERANCE_UM};
     let sys = Eye::navarro_wide().system().unwrap();
     let probe = Probe {
         sys: &sys,
@@ -165,7 +165,7 @@ fn field_plan_covers_the_frame_with_the_coarsest_passing_steps() {
         m.measurement.coefficients_um
     };
     let fewer = a.h_deg.len() - 1;
-    let xs = ocular::psf::axes::linspace(-h, h, fewer);
+    let xs = ocular::psf::linspace(-h, h, fewer);
     let mut worst_fewer = 0.0f64;
     for k in 0..fewer - 1 {
         let (c0, c1) = (coeffs([xs[k], 0.0]), coeffs([xs[k + 1], 0.0]));

@@ -375,9 +375,7 @@ fn traced_radial_skewness(theta_deg: f64) -> f64 {
 /// Skewness along screen x of the green kernel ocular makes for field (h, 0), object at
 /// infinity on the relaxed wide-angle eye (the kernels' orientation: columns = screen x).
 fn kernel_skewness(h_deg: f64) -> f64 {
-    use ocular::psf::axes::{KernelSettings, Screen};
-    use ocular::psf::field::field_column;
-    use ocular::psf::field_psf::cropped_psf;
+    use ocular::psf::{cropped_psf, field_column, KernelSettings, Screen};
     let settings = KernelSettings::default();
     let col = field_column(
         &Eye::navarro_wide(),

@@ -11,11 +11,11 @@ use common::frames::{frame_renderer, splat_and_truth};
 use common::pixels::max_rgb_difference;
 
 use ocular::eye::resolve;
-use ocular::psf::axes::Screen;
-use ocular::render::frame::{
+use ocular::psf::Screen;
+use ocular::render::splat::{ConvolveWalk, FrameInput, SplatSettings};
+use ocular::render::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
 };
-use ocular::render::splat::{ConvolveWalk, FrameInput, SplatSettings};
 
 const W: usize = 240;
 const H: usize = 135;

@@ -9,11 +9,10 @@ use crate::common;
 use common::frames::{frame_renderer, splat_and_truth};
 
 use ocular::eye::resolve;
-use ocular::psf::axes::Screen;
-use ocular::psf::exact::ExactEye;
-use ocular::render::frame::{dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions};
+use ocular::psf::{ExactEye, Screen};
 use ocular::render::reference::{ExactKernels, DIOPTRE_BIN_D};
 use ocular::render::splat::FrameInput;
+use ocular::render::{dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions};
 
 const W: usize = 160;
 const H: usize = 90;

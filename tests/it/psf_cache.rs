@@ -3,10 +3,10 @@
 
 use crate::common::temp_dir;
 use ocular::eye::Eye;
-use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
-use ocular::psf::cache::{cache_path, cached, grid_key, read_grid, write_grid, CacheOutcome};
-use ocular::psf::grid::{compute_grid, no_progress, GridReport};
-use ocular::psf::kernels::{DioptreAxis, KernelGrid};
+use ocular::psf::{
+    cache_path, cached, compute_grid, grid_key, no_progress, read_grid, write_grid, CacheOutcome,
+    DioptreAxis, GridAxes, GridReport, KernelGrid, KernelSettings, Screen,
+};
 use std::cell::Cell;
 
 fn inputs() -> (Eye, GridAxes, Screen, KernelSettings) {

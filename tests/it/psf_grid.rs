@@ -4,14 +4,11 @@
 
 use ocular::eye::{accommodate, measure, trace_range, Eye, Ray};
 use ocular::optics::defocus_f_from_c20;
-use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
-use ocular::psf::defocus::{ChannelOptics, ColumnOptics};
-use ocular::psf::exact::ExactEye;
-use ocular::psf::field_psf::cropped_psf;
-use ocular::psf::grid::{compute_grid, no_progress};
-use ocular::psf::kernels::{kernel_side, level_block_radius, level_count, DioptreAxis};
-use ocular::psf::plan::{plan_for_scene, SceneNeeds};
-use ocular::psf::project::{cropped_psf_at_f, CroppedPsf};
+use ocular::psf::{
+    compute_grid, cropped_psf, cropped_psf_at_f, kernel_side, level_block_radius, level_count,
+    no_progress, plan_for_scene, ChannelOptics, ColumnOptics, CroppedPsf, DioptreAxis, ExactEye,
+    GridAxes, KernelSettings, SceneNeeds, Screen,
+};
 use ocular::render::reference::ExactKernels;
 
 const WL: [f64; 3] = [612.0, 549.0, 464.0];

@@ -17,12 +17,9 @@ use num_complex::Complex64;
 use ocular::eye::Eye;
 use ocular::optics::gauss_legendre_01;
 use ocular::optics::zernike::{wavefront, wavefront_gradient};
-use ocular::psf::axes::{GridAxes, KernelSettings, MethodChoice, Screen};
-use ocular::psf::defocus::ChannelOptics;
-use ocular::psf::exact::ExactEye;
-use ocular::psf::grid::{compute_grid, no_progress};
-use ocular::psf::kernels::{
-    level_block_radius, level_count, level_of_radius, level_radius_px, DioptreAxis,
+use ocular::psf::{
+    compute_grid, level_block_radius, level_count, level_of_radius, level_radius_px, no_progress,
+    ChannelOptics, DioptreAxis, ExactEye, GridAxes, KernelSettings, MethodChoice, Screen,
 };
 use rayon::prelude::*;
 use std::f64::consts::PI;

@@ -6,7 +6,7 @@
 use crate::common;
 
 use common::synthetic::SyntheticEye;
-use ocular::psf::kernels::{kernel_side, level_block_radius, level_of_radius, level_radius_px};
+use ocular::psf::{kernel_side, level_block_radius, level_of_radius, level_radius_px};
 
 /// A kernel as (block radius, values), normalised.
 type Kernel = (u32, Vec<f64>);

@@ -272,7 +272,7 @@ fn depth_is_never_taken_from_the_wrong_pass_or_part() {
 
 #[test]
 fn the_depth_policy_counts_background_invalid_and_near_pixels() {
-    use ocular::inputs::depth::apply;
+    use ocular::inputs::apply;
     let raw = [
         1e10,
         f32::INFINITY,

@@ -11,10 +11,8 @@ use crate::common;
 use crate::common::{ocular, temp_dir};
 use std::path::Path;
 
-use ocular::psf::axes::{GridAxes, Screen};
-use ocular::psf::plan::plan_for_scene;
-use ocular::render::frame::{dioptre_range, scene_needs, EyeState};
-use ocular::render::Rasterizer;
+use ocular::psf::{plan_for_scene, GridAxes, Screen};
+use ocular::render::{dioptre_range, scene_needs, EyeState, Rasterizer};
 use ocular::scene::Scene;
 
 const SIZES: [(u32, u32); 3] = [(64, 36), (160, 90), (1280, 720)];

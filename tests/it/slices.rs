@@ -6,10 +6,9 @@ use crate::common;
 use common::pixels::opaque_pixels;
 use common::synthetic::{ExactSynthetic, SyntheticEye};
 use ocular::metrics::{psnr, ssim, ImageView};
-use ocular::psf::kernels::DioptreAxis;
-use ocular::render::blend::BlendSettings;
+use ocular::psf::DioptreAxis;
 use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
-use ocular::render::{reference, slices};
+use ocular::render::{reference, slices, BlendSettings};
 
 #[test]
 fn slices_are_finite_and_clearly_worse_than_splatting() {

@@ -9,7 +9,7 @@ use common::splat_cpu;
 use common::synthetic::{ExactSynthetic, SyntheticEye, NO_MERGE};
 use ocular::gpu::texture_probe::TextureProbe;
 use ocular::gpu::Context;
-use ocular::psf::kernels::{
+use ocular::psf::{
     kernel_side, level_block_radius, level_count, level_of_radius, level_radius_px, DioptreAxis,
     KernelGrid,
 };

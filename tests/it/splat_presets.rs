@@ -9,11 +9,11 @@ use common::frames::{frame_renderer, splat_and_truth};
 
 use ocular::eye::resolve;
 use ocular::metrics::{psnr, ssim, ImageView};
-use ocular::psf::axes::Screen;
-use ocular::render::frame::{
+use ocular::psf::Screen;
+use ocular::render::splat::FrameInput;
+use ocular::render::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions, Method,
 };
-use ocular::render::splat::FrameInput;
 
 const W: u32 = 96;
 const H: u32 = 54;

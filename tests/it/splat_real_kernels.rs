@@ -7,11 +7,10 @@ use crate::common;
 use common::pixels::{opaque_pixels, psnr};
 
 use ocular::eye::Eye;
-use ocular::psf::axes::{GridAxes, KernelSettings, Screen};
-use ocular::psf::defocus::ColumnOptics;
-use ocular::psf::exact::ExactEye;
-use ocular::psf::grid::{kernels_from_columns, no_progress};
-use ocular::psf::plan::{plan_for_scene, SceneNeeds};
+use ocular::psf::{
+    kernels_from_columns, no_progress, plan_for_scene, ColumnOptics, ExactEye, GridAxes,
+    KernelSettings, SceneNeeds, Screen,
+};
 use ocular::render::reference;
 use ocular::render::splat::{FrameInput, SplatSettings, Splatter, ViewState};
 

@@ -7,9 +7,7 @@ use crate::common::scenes::square_scene;
 
 use ocular::eye::resolve;
 use ocular::metrics::{psnr, ImageView};
-use ocular::psf::axes::{KernelSettings, Screen, DEFAULT_WAVELENGTHS_NM};
-use ocular::psf::defocus::ColumnOptics;
-use ocular::psf::exact::ExactEye;
+use ocular::psf::{ColumnOptics, ExactEye, KernelSettings, Screen, DEFAULT_WAVELENGTHS_NM};
 use ocular::render::{views, Rasterizer};
 use ocular::scene::Scene;
 

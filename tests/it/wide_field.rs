@@ -7,11 +7,9 @@
 use crate::common;
 
 use common::synthetic::{ExactSynthetic, SyntheticEye};
-use ocular::psf::kernels::DioptreAxis;
-use ocular::render::blend::BlendSettings;
-use ocular::render::frame::dioptre_range;
-use ocular::render::reference;
+use ocular::psf::DioptreAxis;
 use ocular::render::splat::{FrameInput, MergeSettings, SplatSettings, Splatter, ViewState};
+use ocular::render::{dioptre_range, reference, BlendSettings};
 
 fn settings(blend: BlendSettings) -> SplatSettings {
     SplatSettings {

@@ -12,18 +12,25 @@
 //!
 //! Everything is computed in f64 on float images: an HDR image needs no 8-bit detour, and an
 //! LDR one is used at the precision it has.
+//!
+//! The `pub use` items below are the module's public surface, with [`colour`], [`csf`] and
+//! [`features`], which stay public as the namespaces of FLIP's building blocks (colour spaces,
+//! contrast sensitivity, edge and point detection) that tests check one function at a time.
 
 pub mod colour;
 pub mod csf;
 pub mod features;
-pub mod hdr;
+pub(crate) mod hdr;
 mod ldr;
 mod plane;
-pub mod pooling;
+pub(crate) mod pooling;
 
-pub use hdr::{hdr_flip, ExposureRange, HdrFlip, HdrSettings, ToneMapper};
+// LDR-FLIP and its two error maps.
 pub use ldr::{colour_error_map, feature_difference_map, ldr_flip};
 pub use plane::Plane;
+// HDR-FLIP: exposures and tone mapping.
+pub use hdr::{exposure_range, hdr_flip, ExposureRange, HdrFlip, HdrSettings, ToneMapper};
+// Pooled statistics and the colour map.
 pub use pooling::{magma, FlipStats};
 
 /// Pixels per degree of a viewer `distance_m` from a monitor `width_m` wide showing

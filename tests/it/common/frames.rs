@@ -3,8 +3,8 @@
 
 use ocular::eye::Eye;
 use ocular::gpu::Context;
-use ocular::render::frame::{EyeState, FrameRenderer, KernelOptions, Method, PreparedKernels};
 use ocular::render::splat::{FrameInput, SplatSettings};
+use ocular::render::{EyeState, FrameRenderer, KernelOptions, Method, PreparedKernels};
 
 /// A renderer of `kernels` for `eye`, splatting with the default settings.
 pub fn frame_renderer(

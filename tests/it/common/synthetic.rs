@@ -3,7 +3,7 @@
 //! focus, and the kernel shape is a soft disc whose asymmetry varies smoothly with dioptres
 //! (so that orientation mistakes and interpolation over distance both show).
 
-use ocular::psf::kernels::{
+use ocular::psf::{
     level_block_radius, level_count, level_radius_px, DioptreAxis, KernelGrid, KernelSet,
 };
 use ocular::render::reference::{ExactKernels, Kernel};
