@@ -2,8 +2,9 @@
 //! is one Rust file plus GLSL files of the same stem under glsl/render/.
 //!
 //! The `pub use` items below are the module's public surface. Four submodules stay public:
-//! [`splat`], the tiled splatting renderer, and [`reference`], [`slices`] and [`views`], three
-//! other renderers whose entry point is each called `render` (re-exporting them would collide).
+//! [`splat`], the tiled splatting renderer, and [`reference`](mod@reference), [`slices`] and
+//! [`views`], three other renderers whose entry point is each called `render` (re-exporting
+//! them would collide).
 
 pub(crate) mod blend;
 pub(crate) mod edge_band;
