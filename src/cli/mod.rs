@@ -196,6 +196,17 @@ pub struct SplatArgs {
         allow_hyphen_values = true
     )]
     pub merge_color_error: f32,
+    /// In the wide field, the most (px) that a merged block's one kernel read may misplace its
+    /// edge pixels: off the centre a block's pixels lie cos²θ·δ apart in kernel space, not δ,
+    /// so a block of side s merges only where (1 − cos²θ)·s/2 is at most this (default 0.02;
+    /// 0 merges only at the centre of the frame; a large value ignores the local scale).
+    #[arg(
+        long,
+        value_name = "PX",
+        default_value_t = crate::render::splat::MergeSettings::DEFAULT_SCALE_ERROR_PX,
+        allow_hyphen_values = true
+    )]
+    pub merge_scale_error: f32,
     /// Read kernels at the radius levels around each fragment's radius (up to three filtered
     /// reads per pixel and fragment) instead of each object distance's own kernel (one read).
     /// By default the layer kernels are used where neighbouring distances' radii differ by at
@@ -222,6 +233,7 @@ impl SplatArgs {
                 blur_per_block: self.merge_blur_per_block,
                 min_radius_px: self.merge_min_radius,
                 color_error: self.merge_color_error,
+                scale_error_px: self.merge_scale_error,
                 ..crate::render::splat::MergeSettings::default()
             },
             blend: self.blend.settings(),

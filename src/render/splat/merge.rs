@@ -15,20 +15,23 @@ shader_block! {
         /// Level of detail by blur (see [`super::MergeSettings::blur_per_block`]); 0: the seed
         /// paper's tolerances.
         pub blur_per_block: f32,
+        /// See [`super::MergeSettings::scale_error_px`].
+        pub scale_error_px: f32,
     }
 }
 
 super::passes::compute_pass!(MergePass, "merge", RENDER_SPLAT_MERGE_COMP, push: MergePush);
 
 impl MergePass {
-    /// `levels`: 1 merges 2×2 blocks, 2 also merges 2×2 blocks of merged blocks, and so on.
+    /// `merge.levels`: 1 merges 2×2 blocks, 2 also merges 2×2 blocks of merged blocks, and so
+    /// on.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
         r: &Resources<'_>,
-        (levels, blur_per_block): (u32, f32),
+        merge: &super::MergeSettings,
     ) -> GpuResult<()> {
-        for level in 1..=levels {
+        for level in 1..=merge.levels {
             let size = 1u32 << level;
             let blocks = [r.block.values.width / size, r.block.values.height / size];
             if blocks[0] == 0 || blocks[1] == 0 {
@@ -40,7 +43,8 @@ impl MergePass {
                 .read("FrameUniform", r.block.buffer)
                 .push(&MergePush {
                     block_size: size,
-                    blur_per_block,
+                    blur_per_block: merge.blur_per_block,
+                    scale_error_px: merge.scale_error_px,
                 })
                 .dispatch([blocks[0].div_ceil(8), blocks[1].div_ceil(8), 1])?;
         }

@@ -662,9 +662,7 @@ impl Splatter {
         let merge = &self.settings.merge;
         if merge.levels > 0 {
             rec.begin_pass("merge");
-            self.passes
-                .merge
-                .record(rec, r, (merge.levels, merge.blur_per_block))?;
+            self.passes.merge.record(rec, r, merge)?;
         }
         rec.begin_pass("tile count");
         // Alpha 0 marks a pixel the convolution has not written (it writes alpha 1 to every

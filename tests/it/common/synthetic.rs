@@ -16,6 +16,7 @@ pub const NO_MERGE: MergeSettings = MergeSettings {
     min_radius_px: 5.0,
     color_error: MergeSettings::DEFAULT_COLOR_ERROR,
     dioptre_tolerance: 0.01,
+    scale_error_px: MergeSettings::DEFAULT_SCALE_ERROR_PX,
 };
 
 #[derive(Clone, Debug)]
