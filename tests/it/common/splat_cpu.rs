@@ -118,6 +118,16 @@ pub fn merge_level(
             {
                 continue;
             }
+            // Off the centre the block's pixels lie cos²θ·δ apart in kernel space while its one
+            // read assumes δ: the edge pixels' misplacement is bounded.
+            let centre = (
+                (bx * size) as f32 + 0.5 * size as f32,
+                (by * size) as f32 + 0.5 * size as f32,
+            );
+            let c = frame.cos_theta(centre.0, centre.1).powi(2);
+            if (1.0 - c) * 0.5 * size as f32 > settings.scale_error_px {
+                continue;
+            }
             let (lo, hi) = f
                 .iter()
                 .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), x| {
