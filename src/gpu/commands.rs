@@ -4,7 +4,7 @@
 use ash::vk;
 
 use super::access::{binding_access, Hazards, Resource};
-use super::buffer::Buffer;
+use super::buffer::{Buffer, Residency};
 use super::context::Context;
 use super::error::{GpuError, GpuResult, VkContext};
 use super::image::Image;
@@ -707,5 +707,47 @@ impl<'a> Recorder<'a> {
             }
         }
         Ok(())
+    }
+}
+
+impl Context {
+    /// Copies `bytes` to a resource named `name` through a new staging buffer, which `copy`
+    /// reads in one submission.
+    pub(crate) fn upload_staged(
+        &self,
+        name: &str,
+        bytes: &[u8],
+        copy: impl FnOnce(&mut Recorder<'_>, &Buffer),
+    ) -> GpuResult<()> {
+        let len = bytes.len() as u64;
+        let mut staging = Buffer::new(self, &format!("{name} staging"), len, Residency::Upload)?;
+        // Buffers are at least 16 bytes: a tiny upload fills only the start of its staging.
+        staging.write_mapped(0, bytes)?;
+        self.submit(|rec| {
+            copy(rec, &staging);
+            Ok(())
+        })?;
+        Ok(())
+    }
+
+    /// A new read-back buffer of `bytes` that `copy` fills from a resource named `name`, in one
+    /// submission.
+    pub(crate) fn read_staged(
+        &self,
+        name: &str,
+        bytes: u64,
+        copy: impl FnOnce(&mut Recorder<'_>, &Buffer),
+    ) -> GpuResult<Buffer> {
+        let readback = Buffer::new(
+            self,
+            &format!("{name} readback"),
+            bytes,
+            Residency::Readback,
+        )?;
+        self.submit(|rec| {
+            copy(rec, &readback);
+            Ok(())
+        })?;
+        Ok(readback)
     }
 }

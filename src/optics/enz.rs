@@ -17,9 +17,9 @@
 //! per (aberration, f) and the r-dependence costs one Bessel sequence per radius.
 
 use super::bessel::{bessel_j, bessel_j_sequence, spherical_j_sequence};
+use super::error::{check_range, OpticsError};
 use super::quadrature::gauss_legendre_01;
 use super::zernike::{is_valid_nm, osa_index, osa_nm, radial};
-use super::{check_range, OpticsError};
 use num_complex::Complex64;
 use std::f64::consts::PI;
 

@@ -18,8 +18,8 @@
 //! order in du), and the sum is normalised by the sampled area, so that an unaberrated pupil
 //! has U(0) = 1 exactly.
 
+use super::error::{check_range, OpticsError};
 use super::zernike::wavefront;
-use super::OpticsError;
 use num_complex::Complex32;
 use rustfft::FftPlanner;
 use std::f64::consts::PI;
@@ -76,9 +76,9 @@ pub fn psf_by_fft(
     pitch: f64,
     size: usize,
 ) -> Result<Vec<f64>, OpticsError> {
-    super::check_range("pitch", pitch, 1e-4, 1e3, "1e-4 to 1000 lambda/NA")?;
-    super::check_range("defocus_f", defocus_f, -1e5, 1e5, "|f| <= 1e5")?;
-    super::check_range(
+    check_range("pitch", pitch, 1e-4, 1e3, "1e-4 to 1000 lambda/NA")?;
+    check_range("defocus_f", defocus_f, -1e5, 1e5, "|f| <= 1e5")?;
+    check_range(
         "wavelength_nm",
         wavelength_nm,
         350.0,

@@ -30,9 +30,9 @@
 use super::amplitude::{AmplitudeTable, Block8, LagrangeRule, RadialAmplitude};
 use super::beta::{beta_from_alpha, BetaExpansion, StilesCrawford};
 use super::enz::MAX_ABS_F;
+use super::error::{check_range, OpticsError};
 use super::quadrature::fejer1_01;
 use super::zernike::{is_valid_nm, num_terms, osa_index};
-use super::{check_range, OpticsError};
 use num_complex::Complex64;
 use rayon::prelude::*;
 use std::f64::consts::PI;
