@@ -81,7 +81,7 @@ void main() {
     // radial shrink, cos²θ), not δ, while its one read (the block-summed kernel, or a 2×2
     // block's bilinear midpoint) assumes δ: merge only where that misplaces the block's edge
     // pixels by at most push.scale_error_px. True PSFs vary texel to texel, so even a 2×2
-    // block off by 0.1–0.4 px changed colonnade's blurred lamps by up to 8 % (the seed's rule
+    // block off by 0.1–0.4 px put a two-pixel pattern into colonnade's blurred lamps (the seed's rule
     // is c = 1 everywhere: the narrow field).
     vec3 s = local_scale(vec2(origin) + 0.5 * float(size));
     float c = s.z * s.z;

@@ -32,7 +32,7 @@ pub struct MergeSettings {
     /// pixels' kernels: the block's pixels lie c·δ apart in kernel space (c = cos²θ, the
     /// local radial shrink) while the read assumes δ, so a block of side s merges only where
     /// (1 − c)·s/2 is at most this. True PSFs vary texel to texel: without this bound, 2×2
-    /// blocks off by 0.1–0.4 px changed colonnade's blurred lamps by up to 8 %.
+    /// blocks off by 0.1–0.4 px put a two-pixel pattern into colonnade's blurred lamps.
     pub scale_error_px: f32,
 }
 
