@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""The table of what the wide-field merge bound costs on a GPU, from a folder that
+tools/gpu_merge_bound.sh wrote.
+
+    tools/gpu_merge_table.py OUT_DIR
+
+One Markdown row per scene, eye and size: kernel evaluations per pixel and the splat's GPU time
+(every pass but the draw, `raster`, which is reported apart) for the default bound, the rule
+before it (`--merge-scale-error 1000`) and merging off, and the draw. Off-axis rows follow, with
+their ratio to the on-axis default row. Nothing is computed but sums and ratios of the
+`ocular bench --json` reports.
+"""
+import glob
+import json
+import os
+import sys
+
+VARIANTS = ["default", "old_rule", "unmerged"]
+
+
+def load(folder):
+    runs = {}
+    for variant in VARIANTS:
+        for path in glob.glob(os.path.join(folder, variant, "*.json")):
+            with open(path) as f:
+                r = json.load(f)
+            key = (r["scene"], r["eye"], r["width"], r["height"], r.get("field") is not None)
+            runs[(variant,) + key] = r
+    return runs
+
+
+def splat_ms(r):
+    raster = sum(p["mean_ms"] for p in r["passes"] if p["name"] == "raster")
+    return r["total"]["mean_ms"] - raster, raster
+
+
+def cell(r, what):
+    if r is None:
+        return "—"
+    if what == "evals":
+        return f"{r['evaluations_per_pixel']:.0f}"
+    return f"{splat_ms(r)[0]:.2f}"
+
+
+def main(folder):
+    runs = load(folder)
+    device = next((r["device"] for r in runs.values()), "no device")
+    print(f"Device: {device}. Splat = GPU time of every pass but the draw (`raster`).\n")
+    print("| scene | eye | size | evaluations / px: default / old rule / off | splat ms: "
+          "default / old rule / off | default ÷ old rule | draw ms |")
+    print("|---|---|---|---|---|---|---|")
+    keys = sorted({k[1:] for k in runs if not k[5]}, key=lambda k: (k[2] * k[3], k[0], k[1]))
+    for scene, eye, w, h, _ in keys:
+        rs = [runs.get((v, scene, eye, w, h, False)) for v in VARIANTS]
+        ev = " / ".join(cell(r, "evals") for r in rs)
+        ms = " / ".join(cell(r, "ms") for r in rs)
+        ratio = (f"{splat_ms(rs[0])[0] / splat_ms(rs[1])[0]:.2f}×" if rs[0] and rs[1] else "—")
+        draw = f"{splat_ms(next(r for r in rs if r))[1]:.2f}"
+        print(f"| {scene} | {eye} | {w}×{h} | {ev} | {ms} | {ratio} | {draw} |")
+    off = sorted(k for k in runs if k[5])
+    if off:
+        print("\n| off axis | eye | size | splat ms | on-axis default splat ms | ratio |")
+        print("|---|---|---|---|---|---|")
+        for k in off:
+            r = runs[k]
+            on = runs.get(("default",) + k[1:5] + (False,))
+            s = splat_ms(r)[0]
+            o = splat_ms(on)[0] if on else None
+            ratio = f"{s / o:.2f}×" if o else "—"
+            print(f"| {k[1]} | {k[2]} | {k[3]}×{k[4]} | {s:.2f} | "
+                  f"{o:.2f} | {ratio} |" if o else f"| {k[1]} | {k[2]} | {k[3]}×{k[4]} | {s:.2f} | — | — |")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
