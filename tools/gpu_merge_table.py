@@ -1,21 +1,22 @@
 #!/usr/bin/env python3
-"""The table of what the wide-field merge bound costs on a GPU, from a folder that
-tools/gpu_merge_bound.sh wrote.
+"""The table of what merging in the wide field costs on a GPU, from a folder that
+tools/gpu_merge_bound.sh or tools/gpu_vs_bound.sh wrote.
 
     tools/gpu_merge_table.py OUT_DIR
 
 One Markdown row per scene, eye and size: kernel evaluations per pixel and the splat's GPU time
-(every pass but the draw, `raster`, which is reported apart) for the default bound, the rule
-before it (`--merge-scale-error 1000`) and merging off, and the draw. Off-axis rows follow, with
-their ratio to the on-axis default row. Nothing is computed but sums and ratios of the
-`ocular bench --json` reports.
+(every pass but the draw, `raster`, which is reported apart) per variant folder present
+(default, bound, old_rule, unmerged: the scripts' headers say what each ran), each variant's
+splat time over the default's, and the draw. Off-axis rows follow, with their ratio to the
+on-axis default row. Nothing is computed but sums and ratios of the `ocular bench --json`
+reports.
 """
 import glob
 import json
 import os
 import sys
 
-VARIANTS = ["default", "old_rule", "unmerged"]
+VARIANTS = ["default", "bound", "old_rule", "unmerged"]
 
 
 def load(folder):
@@ -45,18 +46,24 @@ def cell(r, what):
 def main(folder):
     runs = load(folder)
     device = next((r["device"] for r in runs.values()), "no device")
+    present = [v for v in VARIANTS if any(k[0] == v for k in runs)]
+    names = " / ".join(present)
+    others = [v for v in present if v != "default"]
     print(f"Device: {device}. Splat = GPU time of every pass but the draw (`raster`).\n")
-    print("| scene | eye | size | evaluations / px: default / old rule / off | splat ms: "
-          "default / old rule / off | default ÷ old rule | draw ms |")
-    print("|---|---|---|---|---|---|---|")
+    print(f"| scene | eye | size | evaluations / px: {names} | splat ms: {names} | "
+          + " | ".join(f"{v} ÷ default" for v in others) + " | draw ms |")
+    print("|---|---|---|---|---|" + "---|" * len(others) + "---|")
     keys = sorted({k[1:] for k in runs if not k[5]}, key=lambda k: (k[2] * k[3], k[0], k[1]))
     for scene, eye, w, h, _ in keys:
-        rs = [runs.get((v, scene, eye, w, h, False)) for v in VARIANTS]
-        ev = " / ".join(cell(r, "evals") for r in rs)
-        ms = " / ".join(cell(r, "ms") for r in rs)
-        ratio = (f"{splat_ms(rs[0])[0] / splat_ms(rs[1])[0]:.2f}×" if rs[0] and rs[1] else "—")
-        draw = f"{splat_ms(next(r for r in rs if r))[1]:.2f}"
-        print(f"| {scene} | {eye} | {w}×{h} | {ev} | {ms} | {ratio} | {draw} |")
+        rs = {v: runs.get((v, scene, eye, w, h, False)) for v in present}
+        ev = " / ".join(cell(rs[v], "evals") for v in present)
+        ms = " / ".join(cell(rs[v], "ms") for v in present)
+        base = rs.get("default")
+        ratios = " | ".join(
+            f"{splat_ms(rs[v])[0] / splat_ms(base)[0]:.2f}×" if rs[v] and base else "—"
+            for v in others)
+        draw = f"{splat_ms(next(r for r in rs.values() if r))[1]:.2f}"
+        print(f"| {scene} | {eye} | {w}×{h} | {ev} | {ms} | {ratios} | {draw} |")
     off = sorted(k for k in runs if k[5])
     if off:
         print("\n| off axis | eye | size | splat ms | on-axis default splat ms | ratio |")

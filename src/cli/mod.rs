@@ -196,10 +196,12 @@ pub struct SplatArgs {
         allow_hyphen_values = true
     )]
     pub merge_color_error: f32,
-    /// In the wide field, the most (px) that a merged block's one kernel read may misplace its
-    /// edge pixels: off the centre a block's pixels lie cos²θ·δ apart in kernel space, not δ,
-    /// so a block of side s merges only where (1 − cos²θ)·s/2 is at most this (default 0.02;
-    /// 0 merges only at the centre of the frame; a large value ignores the local scale).
+    /// In the wide field, where a merged block makes one kernel read (with the radius levels
+    /// or the per-fragment blend), the most (px) that read may misplace its edge pixels: off
+    /// the centre a block's pixels lie cos²θ·δ apart in kernel space, not δ, so a block of side
+    /// s merges only where (1 − cos²θ)·s/2 is at most this (default 0.02; 0 merges only at the
+    /// centre of the frame; a large value ignores the local scale). With the layer kernels and
+    /// depth groups (the default) a merged block reads its pixels where they lie: no bound.
     #[arg(
         long,
         value_name = "PX",

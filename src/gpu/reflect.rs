@@ -427,6 +427,7 @@ mod tests {
                 (12, "FrameUniform", UniformBuffer, Read),
                 (13, "LayerAtlas", StorageBuffer, Read),
                 (14, "layer_texture", SampledImage, Read),
+                (15, "layer_sums", SampledImage, Read),
             ]
         );
         // the frame block: 22 four-byte scalars, std140-packed like repr(C)

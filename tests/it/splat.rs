@@ -576,6 +576,7 @@ fn every_pass_matches_its_cpu_step() {
         max_radius,
         focal_px: (32.0 / 30f64.to_radians().tan()) as f32,
         group_tolerance_d: settings.blend.group_tolerance_d,
+        block_reads: out.stats.layer_kernels,
     };
     let mut cpu = splat_cpu::fragments(&frame, &scene.color, &scene.depth, &grid.sets[0].radius_px);
     let core: Vec<f32> = grid.sets[0]

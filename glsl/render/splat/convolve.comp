@@ -22,6 +22,8 @@
 #define BANDS_BINDING 7
 #define ATLAS_BINDING 8
 #define LAYER_ATLAS_BINDING 13
+#define LAYER_TEXTURE_BINDING 14
+#define LAYER_SUMS_BINDING 15
 #include "splat.glsl"
 #include "band.glsl"
 #include "layer_atlas.glsl"
@@ -29,7 +31,6 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
-layout(binding = 14) uniform sampler3D layer_texture;
 FRAGMENT_BUFFERS(1, 9, 10, 11, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
@@ -88,14 +89,8 @@ vec3 kernel_rgb(vec2 d, float l, float index, uint node, uint size) {
 vec3 kernel_at(Fragment f, vec2 d, uint node) {
     uint size = block_size(f);
     if (LAYERED != 0u) {
-        uint kind = layer_kind(size);
-        if (any(greaterThanEqual(abs(d), vec2(layer_bound(kind))))) {
-            return vec3(0.0);
-        }
-        vec3 extent = vec3(textureSize(layer_texture, 0));
-        vec3 uvw = vec3((vec2(layer_node_origin(node)) + layer_point(kind) + d) / extent.xy,
-                        (f.index + 0.5) / extent.z);
-        return textureLod(layer_texture, uvw, 0.0).rgb / layer_scale();
+        return layer_read(layer_kind(size), d, vec2(layer_node_origin(node)),
+                          (f.index + 0.5) / float(textureSize(layer_texture, 0).z));
     }
     vec3 level = level_of_radius(f.radius);
     vec3 lo = floor(level);
@@ -145,6 +140,22 @@ vec3 fragment_weight(uint j, Fragment f, vec2 d) {
                                    : vec3(1.0) - pow(max(vec3(1.0) - w, vec3(0.0)), vec3(n));
     }
     return w;
+}
+
+// Layered, a merged block in the wide field (layer_atlas.glsl, block_reads): its pixels'
+// kernels summed where they lie in kernel space, at kernel offset k of its centre; s: the
+// local scale (radial unit vector, radial and tangential shrink).
+vec3 wide_block_weight(Fragment f, vec2 k, vec4 s) {
+    uint size = block_size(f);
+    float layer = (f.index + 0.5) / float(textureSize(layer_texture, 0).z);
+    if (size == 2u) {
+        // the four pixels at ±½ from the centre: offsets ±a, ±b in kernel space
+        vec2 a = kernel_offset(s.xy, s.zw, vec2(0.5, 0.5));
+        vec2 b = kernel_offset(s.xy, s.zw, vec2(0.5, -0.5));
+        return layer_read(0u, k - a, vec2(0.0), layer) + layer_read(0u, k + a, vec2(0.0), layer)
+             + layer_read(0u, k - b, vec2(0.0), layer) + layer_read(0u, k + b, vec2(0.0), layer);
+    }
+    return float(size * size) * layer_box(k, block_box(size, s.xy, s.zw), layer);
 }
 
 #include "blend.glsl"
@@ -217,7 +228,10 @@ void main() {
                 vec3 w;
                 if (g.w > 0.5) {
                     vec4 s = batch_scale[j];
-                    w = fragment_weight(j, f, kernel_offset(s.xy, s.zw, d)) * (s.z * s.w);
+                    vec2 k = kernel_offset(s.xy, s.zw, d);
+                    w = LAYERED != 0u && block_size(f) > 1u && block_reads()
+                        ? wide_block_weight(f, k, s) : fragment_weight(j, f, k);
+                    w *= s.z * s.w;
                 } else {
                     w = fragment_weight(j, f, d);
                 }

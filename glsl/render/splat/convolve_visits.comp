@@ -18,6 +18,8 @@
 #define BANDS_BINDING 7
 #define ATLAS_BINDING 8
 #define LAYER_ATLAS_BINDING 13
+#define LAYER_TEXTURE_BINDING 14
+#define LAYER_SUMS_BINDING 15
 #include "splat.glsl"
 #include "band.glsl"
 #include "layer_atlas.glsl"
@@ -25,7 +27,6 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
-layout(binding = 14) uniform sampler3D layer_texture;
 FRAGMENT_BUFFERS(1, 9, 10, 11, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 2) readonly buffer Counts { uint counts[]; };
@@ -174,10 +175,11 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
         uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
         coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
         if (LAYERED != 0u) {
-            // The layer texture's slot for this fragment's kind (plain or its block side).
+            // The layer texture's slot for this fragment's kind (plain or its block side), and
+            // in the second read's place the offset added to the slot's kernel offset.
             uint kind = layer_kind(block_size(f));
-            slot_read[READS * j + i] =
-                vec4(layer_point(kind), used ? layer_bound(kind) : 0.0, coef[i].r);
+            slot_read[READS * j + i] = i == 1u ? vec4(0.0)
+                : vec4(layer_point(kind), used ? layer_bound(kind) : 0.0, coef[i].r);
         } else {
             // A merged block of 4×4 and up reads its side's block-summed kernel (kernel_slot).
             uint at = kernel_slot(l, block_size(f));
@@ -190,10 +192,45 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
 }
 
+// Layered, a merged block in the wide field (layer_atlas.glsl, block_reads) takes four slots
+// of one read each, s = 0 … 3: a 2×2 block its four pixels' kernels where they lie in kernel
+// space, a larger block the four corners of its box in the summed-area table with signs
+// + − − +. Each slot carries its share of the coefficient and the offset of its read.
+void fill_wide_block_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale,
+                          float post, float pixels) {
+    fill_slot(j, f, plan, 0u, reach, scale, post, pixels);
+    vec2 corner = vec2((s & 1u) == 0u ? 1.0 : -1.0, s < 2u ? 1.0 : -1.0);
+    uint size = block_size(f);
+    float share;
+    vec2 shift;
+    if (size == 2u) {
+        shift = -kernel_offset(scale.xy, scale.zw, 0.5 * corner);
+        share = 0.25;
+        slot_read[READS * j] = vec4(layer_point(0u), layer_bound(0u), 0.0);
+    } else {
+        vec2 h = block_box(size, scale.xy, scale.zw);
+        shift = corner * h;
+        share = corner.x * corner.y / (4.0 * h.x * h.y);
+        slot_read[READS * j] = vec4(sat_point(), float(layer_header.w) + 0.5, 0.0);
+    }
+    slot_read[READS * j].w = share * plan.coefs[0].r;
+    slot_read[READS * j + 1u] = vec4(shift, 0.0, 0.0);
+    vec4 gb = slot_gb[2u * j];
+    slot_gb[2u * j] = vec4(share * gb.xy, gb.zw);
+}
+
 // Read i of slot j at kernel offset d in the region whose origin is `node`.
 vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 extent) {
     vec4 at = slot_read[READS * j + i];
     vec3 w = vec3(0.0);
+    if (LAYERED != 0u) {
+        // Clamped to the bound, where the slot's zero ring (or the table's edge) lies. Every
+        // layered read comes from the single floats, which hold the tables too: one texture,
+        // so a CPU implementation makes one read per visit.
+        vec2 q = clamp(d + slot_read[READS * j + 1u].xy, vec2(-at.z), vec2(at.z));
+        vec3 uvw = vec3((node + at.xy + q) / extent, layer);
+        return vec3(at.w, gb_r.xy) * textureLod(layer_sums, uvw, 0.0).rgb;
+    }
     // Past the block's zero ring lie other blocks: nothing counts there. An unused read's
     // bound is 0. (A GPU skips the read here; a CPU implementation reads and discards.)
     if (all(lessThan(abs(d), vec2(at.z)))) {
@@ -290,6 +327,9 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
             pixels = !grouped && size > 1u ? n_px : 1.0;
             plan = plan_reads(f, pre);
             slots = plan.slots;
+            if (LAYERED != 0u && size > 1u && scaled && block_reads()) {
+                slots = 4u;
+            }
         }
         entry_slots[local_index] = slots;
         if (local_index == 0u) {
@@ -310,9 +350,15 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
         // very test the pixels make below.
         if (fits) {
             atomicAdd(batch_taken, 1u);
-            [[unroll]] for (uint k = 0u; k < 3u; k++) {
-                if (k < slots) {
-                    fill_slot(first + k, f, plan, k, reach, scale, post, pixels);
+            if (slots == 4u) {
+                [[unroll]] for (uint k = 0u; k < 4u; k++) {
+                    fill_wide_block_slot(first + k, f, plan, k, reach, scale, post, pixels);
+                }
+            } else {
+                [[unroll]] for (uint k = 0u; k < 3u; k++) {
+                    if (k < slots) {
+                        fill_slot(first + k, f, plan, k, reach, scale, post, pixels);
+                    }
                 }
             }
             if (OFF_AXIS != 0u) {
@@ -437,7 +483,7 @@ void main() {
         Gg[q] = vec3(0.0);
         last[q] = -1.0;
     }
-    walk_slots(n, base, ty, vec3(LAYERED != 0u ? textureSize(layer_texture, 0)
+    walk_slots(n, base, ty, vec3(LAYERED != 0u ? textureSize(layer_sums, 0)
                                                : textureSize(psf_texture, 0)));
 
     [[unroll]] for (uint q = 0u; q < PIXELS; q++) {

@@ -20,12 +20,15 @@ layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(binding = 0) uniform sampler3D psf_texture;
 layout(binding = 1) writeonly uniform image3D layer_texture;
+// The same slots in single floats, and the summed-area tables, summed in place (the layer
+// texture itself where that is single floats: src/render/splat/construct.rs).
+layout(binding = 6, rgba32f) coherent uniform image3D layer_sums;
 layout(std430, binding = 2) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
 
 // One dispatch per field node and kind (`LayerKernelsPush` in src/render/splat/layer_kernels.rs).
 layout(push_constant) uniform LayerKernelsPush {
     uint node;
-    uint kind;  // 0: plain; 1 … 4: blocks of side 4 … 32
+    uint kind;  // 0: plain; 1 … 4: blocks of side 4 … 32; 5: the summed-area table
 } push;
 
 // Channel values of radius level `level`'s kernel for blocks of side s (0: plain) at integer
@@ -51,8 +54,60 @@ vec3 level_texel(uint level, uint s, ivec2 u, uint o) {
     return texelFetch(psf_texture, ivec3(at, int(o)), 0).rgb / (k * k);
 }
 
+// The plain kernel of object o at integer offset u (|u| ≤ R), scaled by layer_scale: per
+// channel the two radius levels around the distance's radius, mixed by the fraction between.
+vec3 plain_value(ivec2 u, uint o) {
+    // The distance's radius per channel, clamped as the fragments pass clamps it.
+    vec3 radius = min(node_radii[push.node * frame.object_count + o].xyz,
+                      vec3(float(frame.max_radius)));
+    vec3 level = level_of_radius(radius);
+    vec3 lo = floor(level);
+    vec3 t = level - lo;
+    vec3 value;
+    [[unroll]] for (int c = 0; c < 3; c++) {
+        float a = level_texel(uint(lo[c]), 0u, u, o)[c];
+        value[c] = t[c] > 0.0 ? mix(a, level_texel(uint(lo[c]) + 1u, 0u, u, o)[c], t[c]) : a;
+    }
+    return value * layer_scale();
+}
+
+// The summed-area table of object o's plain kernel, one workgroup per object: texel (i, j)
+// holds the sum of the texels at offsets x < i − R, y < j − R, i.e. the integral of the
+// kernel taken as constant over each texel's unit square, up to the corner (i − R − ½,
+// j − R − ½). The table is bilinear between its corners, so a filtered read at any point is
+// that integral exactly. Rows are summed first (each into the texel below its own row), then
+// columns, in place.
+void summed_area(uint o) {
+    int R = int(layer_header.w);
+    int n = 2 * R + 2;
+    uint t = gl_LocalInvocationIndex;
+    ivec2 at = ivec2(layer_kinds[SAT_KIND].xy);
+    for (int b = int(t); b < n - 1; b += 64) {
+        vec3 sum = vec3(0.0);
+        imageStore(layer_sums, ivec3(at + ivec2(0, b + 1), int(o)), vec4(0.0));
+        for (int a = 0; a < n - 1; a++) {
+            sum += plain_value(ivec2(a - R, b - R), o);
+            imageStore(layer_sums, ivec3(at + ivec2(a + 1, b + 1), int(o)), vec4(sum, 0.0));
+        }
+    }
+    memoryBarrierImage();
+    barrier();
+    for (int i = int(t); i < n; i += 64) {
+        vec3 sum = vec3(0.0);
+        imageStore(layer_sums, ivec3(at + ivec2(i, 0), int(o)), vec4(0.0));
+        for (int j = 1; j < n; j++) {
+            sum += imageLoad(layer_sums, ivec3(at + ivec2(i, j), int(o))).rgb;
+            imageStore(layer_sums, ivec3(at + ivec2(i, j), int(o)), vec4(sum, 0.0));
+        }
+    }
+}
+
 void main() {
     uvec3 id = gl_GlobalInvocationID;
+    if (push.kind == SAT_KIND) {
+        summed_area(gl_WorkGroupID.z);
+        return;
+    }
     uvec4 kind = layer_kinds[push.kind];
     uint s = kind.z;
     uint R = layer_header.w;
@@ -65,18 +120,23 @@ void main() {
     ivec2 u = ivec2(id.xy) - ivec2(edge);
     vec3 value = vec3(0.0);
     if (id.x > 0u && id.y > 0u && id.x < side - 1u && id.y < side - 1u) {
-        // The distance's radius per channel, clamped as the fragments pass clamps it.
-        vec3 radius = min(node_radii[push.node * frame.object_count + id.z].xyz,
-                          vec3(float(frame.max_radius)));
-        vec3 level = level_of_radius(radius);
-        vec3 lo = floor(level);
-        vec3 t = level - lo;
-        [[unroll]] for (int c = 0; c < 3; c++) {
-            float a = level_texel(uint(lo[c]), s, u, id.z)[c];
-            value[c] = t[c] > 0.0
-                ? mix(a, level_texel(uint(lo[c]) + 1u, s, u, id.z)[c], t[c]) : a;
+        if (s == 0u) {
+            value = plain_value(u, id.z);
+        } else {
+            vec3 radius = min(node_radii[push.node * frame.object_count + id.z].xyz,
+                              vec3(float(frame.max_radius)));
+            vec3 level = level_of_radius(radius);
+            vec3 lo = floor(level);
+            vec3 t = level - lo;
+            [[unroll]] for (int c = 0; c < 3; c++) {
+                float a = level_texel(uint(lo[c]), s, u, id.z)[c];
+                value[c] = t[c] > 0.0
+                    ? mix(a, level_texel(uint(lo[c]) + 1u, s, u, id.z)[c], t[c]) : a;
+            }
+            value *= layer_scale();
         }
     }
     ivec2 at = ivec2(layer_node_origin(push.node) + kind.xy) + u;
-    imageStore(layer_texture, ivec3(at, int(id.z)), vec4(value * layer_scale(), 0.0));
+    imageStore(layer_texture, ivec3(at, int(id.z)), vec4(value, 0.0));
+    imageStore(layer_sums, ivec3(at, int(id.z)), vec4(value, 0.0));
 }

@@ -77,15 +77,18 @@ void main() {
     if (r_min < max(frame.merge_min_radius, push.blur_per_block * float(size))) {
         return;
     }
-    // (4) In the wide field the block's pixels lie c·δ apart in kernel space (c: the local
-    // radial shrink, cos²θ), not δ, while its one read (the block-summed kernel, or a 2×2
-    // block's bilinear midpoint) assumes δ: merge only where that misplaces the block's edge
-    // pixels by at most push.scale_error_px. True PSFs vary texel to texel, so even a 2×2
-    // block off by 0.1–0.4 px put a two-pixel pattern into colonnade's blurred lamps (the seed's rule
-    // is c = 1 everywhere: the narrow field).
+    // (4) In the wide field the block's pixels lie J·δ apart in kernel space (J = c_t·I +
+    // (c_r − c_t)·e·eᵀ, the local scale: c_r = cos²θ radially, c_t = cos θ tangentially), not
+    // δ. Layered with the depth-group blend, a merged block reads its pixels where they lie
+    // (layer_atlas.glsl, block_reads): no bound. Otherwise its one read (the block-summed
+    // kernel, or a 2×2 block's bilinear midpoint) assumes δ and misplaces its edge pixels by
+    // (1 − c_r)·s/2; true PSFs vary texel to texel, so even a 2×2 block off by 0.1–0.4 px put a
+    // two-pixel pattern into colonnade's blurred lamps. Merge only where that is at most
+    // push.scale_error_px (the seed's rule is J = I everywhere: the narrow field).
     vec3 s = local_scale(vec2(origin) + 0.5 * float(size));
     float c = s.z * s.z;
-    if ((1.0 - c) * 0.5 * float(size) > push.scale_error_px) {
+    bool block_reads = frame.layered != 0u && frame.blend_mode == 0u;
+    if (!block_reads && (1.0 - c) * 0.5 * float(size) > push.scale_error_px) {
         return;
     }
     float lo = 1e30;

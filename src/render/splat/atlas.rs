@@ -265,11 +265,17 @@ impl TextureLayout {
     }
 }
 
+/// The kind of the layer texture's summed-area tables (`LayerLayout::kinds`; SAT_KIND in
+/// glsl/common/layer_atlas.glsl).
+pub(super) const SAT_KIND: usize = 5;
+
 /// Where each object distance's own kernel lies in the layer texture
 /// (glsl/common/layer_atlas.glsl): one region per field node, and in it one slot per kind of
 /// fragment, side by side: the plain kernel ((2R+1)² texels inside a zero ring, R the grid's
-/// largest radius) and per block side s of `blocks` the block-summed one ((2R+s)² inside a
-/// ring). The layer is the object distance, as in the PSF texture.
+/// largest radius), per block side s of `blocks` the block-summed one ((2R+s)² inside a
+/// ring), and the plain kernel's summed-area table ((2R+2)² corners, read clamped), which
+/// merged blocks read in the wide field. The layer is the object distance, as in the PSF
+/// texture.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct LayerLayout {
     pub nodes: u32,
@@ -279,14 +285,15 @@ pub(super) struct LayerLayout {
     pub region: [u32; 2],
     pub columns: u32,
     /// Per kind (0: plain, then the block sides 4, 8, 16, 32): the texel of its offset 0
-    /// within a region and its block side, if the texture holds it.
-    pub kinds: [Option<([u32; 2], u32)>; 5],
+    /// within a region and its block side, if the texture holds it; kind 5 ([`SAT_KIND`]):
+    /// the plain kernel's summed-area table, (2R+2)² corners, and the texel of its first.
+    pub kinds: [Option<([u32; 2], u32)>; 6],
 }
 
 impl LayerLayout {
     pub fn new(max_radius: u32, nodes: u32, objects: u32, blocks: &[BlockKernels]) -> LayerLayout {
         let r = max_radius;
-        let mut kinds = [None; 5];
+        let mut kinds = [None; 6];
         let mut x = 0;
         let mut height = 0;
         let sides = std::iter::once(0).chain(blocks.iter().map(|b| b.side));
@@ -304,6 +311,10 @@ impl LayerLayout {
             x += width;
             height = height.max(width);
         }
+        // Read with clamped coordinates (it is constant past the kernel): no zero ring.
+        kinds[SAT_KIND] = Some(([x, 0], 0));
+        x += 2 * r + 2;
+        height = height.max(2 * r + 2);
         let columns = square_columns(nodes, [x, height]);
         LayerLayout {
             nodes,
@@ -556,15 +567,17 @@ mod tests {
         assert_eq!(l.kinds[1], Some(([43 + 23, 23], 4)));
         assert_eq!(l.kinds[2], None);
         assert_eq!(l.kinds[3], Some(([43 + 46 + 29, 29], 16)));
-        assert_eq!(l.region, [43 + 46 + 58, 58]);
-        assert_eq!(l.extent(), [147, 58, 161]);
-        for (at, side) in l.kinds.iter().flatten() {
+        // the summed-area table: 42 corners from its first texel, after the blocks
+        assert_eq!(l.kinds[SAT_KIND], Some(([43 + 46 + 58, 0], 0)));
+        assert_eq!(l.region, [43 + 46 + 58 + 42, 58]);
+        assert_eq!(l.extent(), [189, 58, 161]);
+        for (at, side) in l.kinds[..SAT_KIND].iter().flatten() {
             let half = 20 + side / 2 + 1;
             assert!(at[0] >= half && at[1] >= half);
             assert!(at[1] + half <= l.region[1] + u32::from(*side == 0));
         }
         let many = LayerLayout::new(20, 12, 161, &[]);
         let [x, y, _] = many.extent();
-        assert!(x.max(y) <= 4 * 43, "{x}×{y}");
+        assert!(x.max(y) <= 4 * (43 + 42), "{x}×{y}");
     }
 }

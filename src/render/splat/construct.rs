@@ -102,6 +102,17 @@ impl Splatter {
         };
         let layer_texture =
             psf_texture::create_texture(ctx, layer_layout.extent(), settings.texture_format)?;
+        // The same kernels in single floats, with the summed-area tables, where the layer
+        // texture holds halves: a merged block's box is a difference of four corners of the
+        // table, which halves would lose (single floats for every read cost the H200 15–30 %).
+        let layer_sums = match settings.texture_format {
+            psf_texture::PsfTextureFormat::Rgba32Float => None,
+            _ => Some(psf_texture::create_texture(
+                ctx,
+                layer_layout.extent(),
+                psf_texture::PsfTextureFormat::Rgba32Float,
+            )?),
+        };
         let layer_atlas = Buffer::from_slice(ctx, "layer texture atlas", &layer_layout.words())?;
         let radii = Buffer::new(
             ctx,
@@ -118,6 +129,7 @@ impl Splatter {
             layer_layout,
             layer_atlas,
             layer_texture,
+            layer_sums,
             layer_kernels,
             field_table,
             node_grids,

@@ -65,6 +65,7 @@ impl ConvolvePass {
             .read("psf_texture", (r.texture, r.sampler))
             .read("Atlas", r.atlas)
             .read("layer_texture", (r.layer_texture, r.sampler))
+            .read("layer_sums", (r.layer_sums, r.sampler))
             .read("LayerAtlas", r.layer_atlas)
             .read("Field", r.field_table)
             .read("Fragments", &r.frame.fragments)

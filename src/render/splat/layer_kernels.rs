@@ -2,9 +2,9 @@
 //! radius levels, so that the convolution reads one texel for all channels. See
 //! glsl/render/splat/layer_kernels.comp.
 
-use crate::gpu::{shader_block, GpuResult, Recorder};
+use crate::gpu::{shader_block, Dispatch, GpuResult, Recorder};
 
-use super::atlas::{layer_slot_width, LayerLayout};
+use super::atlas::{layer_slot_width, LayerLayout, SAT_KIND};
 use super::Resources;
 
 shader_block! {
@@ -13,7 +13,8 @@ shader_block! {
     #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
     pub(super) struct LayerKernelsPush {
         pub node: u32,
-        /// 0: plain; 1 … 4: blocks of side 4 … 32.
+        /// 0: plain; 1 … 4: blocks of side 4 … 32; 5: the plain kernels' summed-area tables
+        /// (one workgroup per object distance).
         pub kind: u32,
     }
 }
@@ -22,7 +23,7 @@ super::passes::compute_pass!(LayerKernelsPass, "layer kernels", RENDER_SPLAT_LAY
 
 impl LayerKernelsPass {
     /// Writes every node's slots of `layout` from the PSF texture, which must hold this
-    /// frame's blend.
+    /// frame's blend, and on axis the plain kernels' summed-area tables.
     pub fn record(
         &self,
         rec: &mut Recorder<'_>,
@@ -30,23 +31,42 @@ impl LayerKernelsPass {
         layout: &LayerLayout,
     ) -> GpuResult<()> {
         for node in 0..layout.nodes {
-            for (kind, slot) in layout.kinds.iter().enumerate() {
+            for (kind, slot) in layout.kinds[..SAT_KIND].iter().enumerate() {
                 let Some((_, side)) = slot else { continue };
                 let width = layer_slot_width(layout.max_radius, *side);
-                rec.compute(&self.pipeline)
-                    .read("psf_texture", (r.texture, r.sampler))
-                    .write("layer_texture", r.layer_texture)
-                    .read("Field", r.field_table)
-                    .read("Atlas", r.atlas)
-                    .read("LayerAtlas", r.layer_atlas)
-                    .read("FrameUniform", r.block.buffer)
-                    .push(&LayerKernelsPush {
-                        node,
-                        kind: kind as u32,
-                    })
+                let push = LayerKernelsPush {
+                    node,
+                    kind: kind as u32,
+                };
+                self.bind(rec, r, &push)
                     .dispatch([width.div_ceil(8), width.div_ceil(8), layout.objects])?;
             }
         }
+        // The summed-area tables: one workgroup per object distance, on axis (one node).
+        if layout.nodes == 1 && layout.kinds[SAT_KIND].is_some() {
+            let push = LayerKernelsPush {
+                node: 0,
+                kind: SAT_KIND as u32,
+            };
+            self.bind(rec, r, &push).dispatch([1, 1, layout.objects])?;
+        }
         Ok(())
+    }
+
+    fn bind<'r, 'rec, 'a>(
+        &'a self,
+        rec: &'r mut Recorder<'rec>,
+        r: &Resources<'a>,
+        push: &'a LayerKernelsPush,
+    ) -> Dispatch<'r, 'rec, 'a> {
+        rec.compute(&self.pipeline)
+            .read("psf_texture", (r.texture, r.sampler))
+            .write("layer_texture", r.layer_texture)
+            .write("layer_sums", r.layer_sums)
+            .read("Field", r.field_table)
+            .read("Atlas", r.atlas)
+            .read("LayerAtlas", r.layer_atlas)
+            .read("FrameUniform", r.block.buffer)
+            .push(push)
     }
 }

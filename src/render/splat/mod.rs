@@ -192,6 +192,9 @@ struct Resources<'a> {
     sampler: &'a Sampler,
     atlas: &'a Buffer,
     layer_texture: &'a Image,
+    /// The layer kernels and their summed-area tables in single floats (the layer texture
+    /// itself where that is single floats).
+    layer_sums: &'a Image,
     layer_atlas: &'a Buffer,
 }
 
@@ -215,6 +218,10 @@ pub struct Splatter {
     layer_layout: atlas::LayerLayout,
     layer_atlas: Buffer,
     layer_texture: Image,
+    /// Where the layer texture holds halves: the same slots in single floats, with the
+    /// summed-area tables that merged blocks read in the wide field
+    /// (glsl/common/layer_atlas.glsl); None where the layer texture is single floats.
+    layer_sums: Option<Image>,
     layer_kernels: bool,
     field_table: field::FieldTable,
     texture: Image,
@@ -277,7 +284,11 @@ impl Splatter {
     /// Device memory of the PSF texture and the layer texture (bytes).
     pub fn psf_texture_bytes(&self) -> u64 {
         let texel = self.settings.texture_format.texel_bytes();
-        self.layout.bytes(texel) + self.layer_layout.bytes(texel)
+        let sums = self
+            .layer_sums
+            .as_ref()
+            .map_or(0, |_| self.layer_layout.bytes(16));
+        self.layout.bytes(texel) + self.layer_layout.bytes(texel) + sums
     }
 
     /// Whether a frame with these per-object radii (xyz, px) reads the layer texture, and the
@@ -613,6 +624,7 @@ impl Splatter {
             sampler: &self.sampler,
             atlas: &self.atlas,
             layer_texture: &self.layer_texture,
+            layer_sums: self.layer_sums.as_ref().unwrap_or(&self.layer_texture),
             layer_atlas: &self.layer_atlas,
         }
     }
@@ -652,6 +664,9 @@ impl Splatter {
                 rec.begin_pass("layer kernels");
                 // The slots' rings and the gaps between regions must read zero (see above).
                 rec.clear_image(&self.layer_texture, [0.0; 4]);
+                if let Some(sums) = &self.layer_sums {
+                    rec.clear_image(sums, [0.0; 4]);
+                }
                 self.passes
                     .layer_kernels
                     .record(rec, r, &self.layer_layout)?;

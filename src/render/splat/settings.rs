@@ -28,11 +28,14 @@ pub struct MergeSettings {
     pub color_error: f32,
     /// Largest summed pairwise dioptre difference in a block, per pair and pixel of blur.
     pub dioptre_tolerance: f32,
-    /// In the wide field, the most (px) that a merged block's one read may misplace its edge
-    /// pixels' kernels: the block's pixels lie c·δ apart in kernel space (c = cos²θ, the
-    /// local radial shrink) while the read assumes δ, so a block of side s merges only where
-    /// (1 − c)·s/2 is at most this. True PSFs vary texel to texel: without this bound, 2×2
-    /// blocks off by 0.1–0.4 px put a two-pixel pattern into colonnade's blurred lamps.
+    /// In the wide field, where a merged block makes one read (the radius levels, or the
+    /// per-fragment blend), the most (px) that read may misplace its edge pixels' kernels: the
+    /// block's pixels lie c·δ apart in kernel space (c = cos²θ, the local radial shrink) while
+    /// the read assumes δ, so a block of side s merges only where (1 − c)·s/2 is at most this.
+    /// True PSFs vary texel to texel: without this bound, 2×2 blocks off by 0.1–0.4 px put a
+    /// two-pixel pattern into colonnade's blurred lamps. With the layer kernels and depth
+    /// groups a merged block reads its pixels where they lie (glsl/common/layer_atlas.glsl,
+    /// `block_reads`), and this does not apply.
     pub scale_error_px: f32,
 }
 

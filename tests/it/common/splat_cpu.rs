@@ -15,6 +15,9 @@ pub struct Frame {
     pub focal_px: f32,
     /// The blend's depth-group tolerance (D): a merged block lies within one group.
     pub group_tolerance_d: f32,
+    /// Whether merged blocks read their pixels where they lie in kernel space (the layer
+    /// kernels with the depth-group blend), so that the wide field does not bound merging.
+    pub block_reads: bool,
 }
 
 impl Frame {
@@ -118,14 +121,15 @@ pub fn merge_level(
             {
                 continue;
             }
-            // Off the centre the block's pixels lie cos²θ·δ apart in kernel space while its one
-            // read assumes δ: the edge pixels' misplacement is bounded.
+            // Off the centre the block's pixels lie cos²θ·δ apart in kernel space; unless they
+            // are read where they lie, the one read assumes δ: the edge pixels' misplacement is
+            // bounded.
             let centre = (
                 (bx * size) as f32 + 0.5 * size as f32,
                 (by * size) as f32 + 0.5 * size as f32,
             );
             let c = frame.cos_theta(centre.0, centre.1).powi(2);
-            if (1.0 - c) * 0.5 * size as f32 > settings.scale_error_px {
+            if !frame.block_reads && (1.0 - c) * 0.5 * size as f32 > settings.scale_error_px {
                 continue;
             }
             let (lo, hi) = f
