@@ -135,6 +135,19 @@ pub struct SplatStats {
     pub layer_kernels: bool,
 }
 
+/// The layer kernels in single floats (`Splatter::layer_sums`; glsl/common/layer_atlas.glsl):
+/// one layer per object distance, region 0 (on axis).
+pub struct LayerSums<'a> {
+    pub image: &'a Image,
+    pub sampler: &'a Sampler,
+    /// The texel of the plain kernel's offset 0.
+    pub plain_texel: [u32; 2],
+    /// The texel of the summed-area table's first corner, (−R − ½, −R − ½).
+    pub table_texel: [u32; 2],
+    /// R: the slots hold kernels up to this radius.
+    pub max_radius_px: u32,
+}
+
 /// Intermediate buffers of a single-band frame, read back for tests.
 #[derive(Clone, Debug, Default)]
 pub struct SplatIntermediates {
@@ -326,6 +339,22 @@ impl Splatter {
     /// Where radius level `level`'s kernel summed over merged blocks of `side` × `side` pixels
     /// (4 … 32) lies at field node `node`, if the texture holds it: the texel whose centre is
     /// offset (+½, +½) from the block's centre (glsl/common/atlas.glsl).
+    /// The layer kernels in single floats as the convolution samples them (for inspection and
+    /// tests); None where this splatter has no layer kernels.
+    pub fn layer_sums(&self) -> Option<LayerSums<'_>> {
+        if !self.layer_kernels {
+            return None;
+        }
+        let kinds = &self.layer_layout.kinds;
+        Some(LayerSums {
+            image: self.layer_sums.as_ref().unwrap_or(&self.layer_texture),
+            sampler: &self.sampler,
+            plain_texel: kinds[0]?.0,
+            table_texel: kinds[atlas::SAT_KIND]?.0,
+            max_radius_px: self.layer_layout.max_radius,
+        })
+    }
+
     pub fn psf_texture_block_centre(&self, node: u32, level: u32, side: u32) -> Option<[u32; 2]> {
         let (b, slot) = self.layout.blocks.iter().find(|(b, _)| b.side == side)?;
         (level >= b.first_level).then(|| {
