@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """The table of what merging in the wide field costs on a GPU, from a folder that
-tools/gpu_merge_bound.sh or tools/gpu_vs_bound.sh wrote.
+tools/gpu_vs_bound.sh wrote.
 
     tools/gpu_merge_table.py OUT_DIR
 
 One Markdown row per scene, eye and size: kernel evaluations per pixel and the splat's GPU time
 (every pass but the draw, `raster`, which is reported apart) per variant folder present
-(default, bound, old_rule, unmerged: the scripts' headers say what each ran), each variant's
+(default, bound, old_rule, unmerged: the script's header says what each ran), each variant's
 splat time over the default's, and the draw. Off-axis rows follow, with their ratio to the
 on-axis default row. Nothing is computed but sums and ratios of the `ocular bench --json`
 reports.

@@ -61,14 +61,12 @@ layout(binding = LAYER_SUMS_BINDING) uniform sampler3D layer_sums;
 // A merged block in the wide field, with the depth-group blend. Its s × s pixels lie J·δ
 // apart in kernel space (J = c_t·I + (c_r − c_t)·e·eᵀ, the local scale's map), not δ, so the
 // block-summed kernels, which assume δ, misplace its edge pixels by (1 − c_r)·s/2. Instead:
-// a 2×2 block reads its four pixels' kernels where they lie (block_reads), exactly what the
+// a 2×2 block reads its four pixels' kernels where they lie, exactly what the
 // pixels would read; a larger block reads its box (layer_box), the kernel's mean over J's
 // diagonal times the block: a bilinear read is the integral of the kernel taken as constant
 // per texel over a unit square, so the pixels' reads sum to about that integral over the
-// parallelogram J·block, and the box is that parallelogram without its shear.
-bool block_reads() {
-    return frame.layered != 0u && frame.blend_mode == 0u;
-}
+// parallelogram J·block, and the box is that parallelogram without its shear. When: block_reads
+// (splat.glsl).
 
 // Kind k's value at kernel offset d in the region at `origin`, at texture layer coordinate
 // `layer`, divided by layer_scale; zero past the kind's bound.

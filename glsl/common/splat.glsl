@@ -112,6 +112,13 @@ vec2 kernel_offset(vec2 e, vec2 c, vec2 d) {
     return c.y * d + (c.x - c.y) * dot(d, e) * e;
 }
 
+// Whether a merged block in the wide field reads its pixels where they lie in kernel space
+// (glsl/common/layer_atlas.glsl: the layer kernels with the depth-group blend), rather than
+// one read that assumes them one texel apart (merge.comp bounds that read's misplacement).
+bool block_reads() {
+    return frame.layered != 0u && frame.blend_mode == 0u;
+}
+
 // Radius levels of the kernel blocks (src/psf/kernels.rs): quarter pixels up to 2 px, whole
 // pixels beyond; level l has a block of radius ceil(level_radius(l)).
 const uint LEVELS_PER_PX = 4u;

@@ -142,7 +142,7 @@ vec3 fragment_weight(uint j, Fragment f, vec2 d) {
     return w;
 }
 
-// Layered, a merged block in the wide field (layer_atlas.glsl, block_reads): its pixels'
+// Layered, a merged block in the wide field (block_reads in splat.glsl): its pixels'
 // kernels summed where they lie in kernel space, at kernel offset k of its centre; s: the
 // local scale (radial unit vector, radial and tangential shrink).
 vec3 wide_block_weight(Fragment f, vec2 k, vec4 s) {

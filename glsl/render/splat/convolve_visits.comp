@@ -192,7 +192,7 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
 }
 
-// Layered, a merged block in the wide field (layer_atlas.glsl, block_reads) takes four slots
+// Layered, a merged block in the wide field (block_reads in splat.glsl) takes four slots
 // of one read each, s = 0 … 3: a 2×2 block its four pixels' kernels where they lie in kernel
 // space, a larger block the four corners of its box in the summed-area table with signs
 // + − − +. Each slot carries its share of the coefficient and the offset of its read.

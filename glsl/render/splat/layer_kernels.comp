@@ -54,9 +54,10 @@ vec3 level_texel(uint level, uint s, ivec2 u, uint o) {
     return texelFetch(psf_texture, ivec3(at, int(o)), 0).rgb / (k * k);
 }
 
-// The plain kernel of object o at integer offset u (|u| ≤ R), scaled by layer_scale: per
-// channel the two radius levels around the distance's radius, mixed by the fraction between.
-vec3 plain_value(ivec2 u, uint o) {
+// Object o's kernel for blocks of side s (0: plain) at integer texel offset u from its offset
+// 0, scaled by layer_scale: per channel the two radius levels around the distance's radius,
+// mixed by the fraction between.
+vec3 kind_value(ivec2 u, uint o, uint s) {
     // The distance's radius per channel, clamped as the fragments pass clamps it.
     vec3 radius = min(node_radii[push.node * frame.object_count + o].xyz,
                       vec3(float(frame.max_radius)));
@@ -65,8 +66,8 @@ vec3 plain_value(ivec2 u, uint o) {
     vec3 t = level - lo;
     vec3 value;
     [[unroll]] for (int c = 0; c < 3; c++) {
-        float a = level_texel(uint(lo[c]), 0u, u, o)[c];
-        value[c] = t[c] > 0.0 ? mix(a, level_texel(uint(lo[c]) + 1u, 0u, u, o)[c], t[c]) : a;
+        float a = level_texel(uint(lo[c]), s, u, o)[c];
+        value[c] = t[c] > 0.0 ? mix(a, level_texel(uint(lo[c]) + 1u, s, u, o)[c], t[c]) : a;
     }
     return value * layer_scale();
 }
@@ -86,7 +87,7 @@ void summed_area(uint o) {
         vec3 sum = vec3(0.0);
         imageStore(layer_sums, ivec3(at + ivec2(0, b + 1), int(o)), vec4(0.0));
         for (int a = 0; a < n - 1; a++) {
-            sum += plain_value(ivec2(a - R, b - R), o);
+            sum += kind_value(ivec2(a - R, b - R), o, 0u);
             imageStore(layer_sums, ivec3(at + ivec2(a + 1, b + 1), int(o)), vec4(sum, 0.0));
         }
     }
@@ -120,21 +121,7 @@ void main() {
     ivec2 u = ivec2(id.xy) - ivec2(edge);
     vec3 value = vec3(0.0);
     if (id.x > 0u && id.y > 0u && id.x < side - 1u && id.y < side - 1u) {
-        if (s == 0u) {
-            value = plain_value(u, id.z);
-        } else {
-            vec3 radius = min(node_radii[push.node * frame.object_count + id.z].xyz,
-                              vec3(float(frame.max_radius)));
-            vec3 level = level_of_radius(radius);
-            vec3 lo = floor(level);
-            vec3 t = level - lo;
-            [[unroll]] for (int c = 0; c < 3; c++) {
-                float a = level_texel(uint(lo[c]), s, u, id.z)[c];
-                value[c] = t[c] > 0.0
-                    ? mix(a, level_texel(uint(lo[c]) + 1u, s, u, id.z)[c], t[c]) : a;
-            }
-            value *= layer_scale();
-        }
+        value = kind_value(u, id.z, s);
     }
     ivec2 at = ivec2(layer_node_origin(push.node) + kind.xy) + u;
     imageStore(layer_texture, ivec3(at, int(id.z)), vec4(value, 0.0));

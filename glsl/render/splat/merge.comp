@@ -80,15 +80,14 @@ void main() {
     // (4) In the wide field the block's pixels lie J·δ apart in kernel space (J = c_t·I +
     // (c_r − c_t)·e·eᵀ, the local scale: c_r = cos²θ radially, c_t = cos θ tangentially), not
     // δ. Layered with the depth-group blend, a merged block reads its pixels where they lie
-    // (layer_atlas.glsl, block_reads): no bound. Otherwise its one read (the block-summed
+    // (block_reads in splat.glsl, layer_atlas.glsl): no bound. Otherwise its one read (the block-summed
     // kernel, or a 2×2 block's bilinear midpoint) assumes δ and misplaces its edge pixels by
     // (1 − c_r)·s/2; true PSFs vary texel to texel, so even a 2×2 block off by 0.1–0.4 px put a
     // two-pixel pattern into colonnade's blurred lamps. Merge only where that is at most
     // push.scale_error_px (the seed's rule is J = I everywhere: the narrow field).
     vec3 s = local_scale(vec2(origin) + 0.5 * float(size));
     float c = s.z * s.z;
-    bool block_reads = frame.layered != 0u && frame.blend_mode == 0u;
-    if (!block_reads && (1.0 - c) * 0.5 * float(size) > push.scale_error_px) {
+    if (!block_reads() && (1.0 - c) * 0.5 * float(size) > push.scale_error_px) {
         return;
     }
     float lo = 1e30;

@@ -34,8 +34,8 @@ pub struct MergeSettings {
     /// the read assumes δ, so a block of side s merges only where (1 − c)·s/2 is at most this.
     /// True PSFs vary texel to texel: without this bound, 2×2 blocks off by 0.1–0.4 px put a
     /// two-pixel pattern into colonnade's blurred lamps. With the layer kernels and depth
-    /// groups a merged block reads its pixels where they lie (glsl/common/layer_atlas.glsl,
-    /// `block_reads`), and this does not apply.
+    /// groups a merged block reads its pixels where they lie (`block_reads` in
+    /// glsl/common/splat.glsl), and this does not apply.
     pub scale_error_px: f32,
 }
 
