@@ -222,6 +222,32 @@ float fragment_reach(Fragment f) {
     return size > 1u ? r + 0.5 : r;
 }
 
+// Filtered texture reads the pixel walk (glsl/render/splat/convolve.comp) makes for one (pixel,
+// fragment) pair within reach, at most, over `nodes` field nodes: what a GPU's convolution
+// spends its time on, where kernel evaluations count the pairs alone (`ocular bench`). Layered:
+// one, or four for a merged block that reads its pixels where they lie in the wide field
+// (block_reads). Radius levels: the levels its channels' radii span (one to three, or two per
+// channel when they span more). Reads past a kernel's bound are skipped by the walk and
+// counted here.
+uint reads_per_evaluation(Fragment f, uint nodes) {
+    float r = max(f.radius.r, max(f.radius.g, f.radius.b));
+    if (frame.layered != 0u) {
+        bool wide = shrink_for_radius(local_scale(f.center).z, r).x < 1.0;
+        return wide && block_size(f) > 1u && block_reads() ? 4u : 1u;
+    }
+    vec3 level = level_of_radius(f.radius);
+    float base = min(floor(level.r), min(floor(level.g), floor(level.b)));
+    float top = max(ceil(level.r), max(ceil(level.g), ceil(level.b)));
+    uint per_node;
+    if (top - base <= 2.0) {
+        per_node = 1u + uint(top - base);
+    } else {
+        bvec3 between = greaterThan(level - floor(level), vec3(0.0));
+        per_node = 3u + uint(between.r) + uint(between.g) + uint(between.b);
+    }
+    return per_node * nodes;
+}
+
 // Inclusive rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of the
 // fragment's centre on both axes (the convolution's reach test). Empty if off screen.
 ivec4 fragment_pixels(Fragment f) {

@@ -130,6 +130,10 @@ struct Report {
     kernel_evaluations: u64,
     /// Kernel evaluations per pixel (per visible pixel; hidden layers add to it).
     evaluations_per_pixel: f64,
+    /// Filtered texture reads the GPU's convolution makes for those evaluations, at most
+    /// (`SplatStats::texture_reads`): what its time follows.
+    texture_reads: u64,
+    texture_reads_per_pixel: f64,
     max_radius_px: u32,
     /// Device memory of the PSF texture (bytes).
     psf_texture_bytes: u64,
@@ -177,6 +181,7 @@ struct TimedFrames {
     list_entries: u64,
     live_fragments: u64,
     kernel_evaluations: u64,
+    texture_reads: u64,
     psf_texture_bytes: u64,
     layer_kernels: bool,
     counters: Counters,
@@ -272,6 +277,7 @@ fn time_frames(
         list_entries: 0,
         live_fragments: 0,
         kernel_evaluations: 0,
+        texture_reads: 0,
         psf_texture_bytes: 0,
         layer_kernels: false,
         counters: Counters::default(),
@@ -299,6 +305,7 @@ fn time_frames(
             t.list_entries = s.list_entries;
             t.live_fragments = s.live_fragments;
             t.kernel_evaluations = s.kernel_evaluations;
+            t.texture_reads = s.texture_reads;
             t.psf_texture_bytes = s.psf_texture_bytes;
             t.layer_kernels = s.layer_kernels;
             t.counters = Counters {
@@ -433,6 +440,9 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         kernel_evaluations: timed.kernel_evaluations,
         evaluations_per_pixel: timed.kernel_evaluations as f64
             / (f64::from(width) * f64::from(height)),
+        texture_reads: timed.texture_reads,
+        texture_reads_per_pixel: timed.texture_reads as f64
+            / (f64::from(width) * f64::from(height)),
         max_radius_px,
         psf_texture_bytes: timed.psf_texture_bytes,
         layer_kernels: timed.layer_kernels,
@@ -542,10 +552,16 @@ fn print_table(r: &Report) {
         r.kernel_evaluations,
         r.evaluations_per_pixel,
         if r.layer_kernels {
-            "one read each (layer kernels)"
+            "layer kernels"
         } else {
-            "up to three reads each (radius levels)"
+            "radius levels"
         }
+    );
+    println!(
+        "texture reads: {} ({:.1} per pixel, {:.2} per evaluation; the GPU walk's, at most)",
+        r.texture_reads,
+        r.texture_reads_per_pixel,
+        r.texture_reads as f64 / (r.kernel_evaluations.max(1) as f64)
     );
     if let Some(f) = &r.field {
         println!(

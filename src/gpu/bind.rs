@@ -398,7 +398,7 @@ mod tests {
     fn families_and_uniform_blocks() {
         let ctx = gpu();
         // glsl/render/splat/tile_count.comp: Fragments0 (0), Counts (1), Fragments1..3 (2..4),
-        // the frame's 80-byte uniform block (5).
+        // the frame's uniform block (5), Field (6).
         let count =
             ComputePipeline::builder("tile count", crate::shaders::RENDER_SPLAT_TILE_COUNT_COMP)
                 .build(&ctx)
@@ -413,9 +413,10 @@ mod tests {
             .read("Fragments", ranges(4))
             .write("Counts", &buffer)
             .read("FrameUniform", &buffer)
+            .read("Field", &buffer)
             .finish()
             .unwrap();
-        assert_eq!(bound.len(), 6);
+        assert_eq!(bound.len(), 7);
         assert!(
             matches!(bound[4], Binding::BufferRange(_, 768, 256)),
             "Fragments3 is binding 4"
@@ -424,7 +425,8 @@ mod tests {
             bind()
                 .read("Fragments", [ranges(4)[0], ranges(4)[1], ranges(4)[2]])
                 .write("Counts", &buffer)
-                .read("FrameUniform", &buffer),
+                .read("FrameUniform", &buffer)
+                .read("Field", &buffer),
         );
         assert!(
             three.contains("nothing bound to \"Fragments3\" (binding 4)"),

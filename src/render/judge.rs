@@ -40,6 +40,9 @@ pub struct MethodResult {
     /// Pixel × fragment pairs inside a kernel's reach, per pixel of the frame (splat only): the
     /// frame's cost read without a clock.
     pub evaluations_per_pixel: Option<f64>,
+    /// Filtered texture reads the GPU's convolution makes for them, per pixel, at most (splat
+    /// only; `SplatStats::texture_reads`).
+    pub texture_reads_per_pixel: Option<f64>,
     /// Depth layers the method saw.
     pub layers: u32,
     /// Quality over the occlusion-edge band (pixels within the local blur radius of a depth
@@ -167,6 +170,10 @@ impl Judge<'_> {
                 .stats
                 .as_ref()
                 .map(|s| s.kernel_evaluations as f64 / (self.width * self.height).max(1) as f64),
+            texture_reads_per_pixel: frame
+                .stats
+                .as_ref()
+                .map(|s| s.texture_reads as f64 / (self.width * self.height).max(1) as f64),
         };
         Ok(Row {
             result,

@@ -486,6 +486,7 @@ fn barriers_follow_declared_access_and_declarations_match_shaders() {
             88 => builder.uniform::<[u32; 22]>(),
             _ => builder.uniform::<[u32; 16]>(),
         }
+        .bindings(&[BindingKind::StorageBuffer]) // the Field table (6), after the uniform
         .build(&ctx)
     };
     assert!(tile_count(88).is_ok());

@@ -753,6 +753,24 @@ fn every_pass_matches_its_cpu_step() {
         out.stats.live_fragments,
         gpu.fragments.iter().filter(|f| f.size > 0).count() as u64
     );
+    // The cost counters: pairs within reach, and the reads the pixel walk makes for them.
+    let (mut evaluations, mut reads) = (0u64, 0u64);
+    for f in gpu.fragments.iter().filter(|f| f.size > 0) {
+        if let Some([x0, y0, x1, y1]) = splat_cpu::reach_rect(&frame, f) {
+            let pairs = ((x1 - x0 + 1) * (y1 - y0 + 1)) as u64;
+            evaluations += pairs;
+            reads += pairs * splat_cpu::reads_per_evaluation(&frame, f, out.stats.layer_kernels);
+        }
+    }
+    assert_eq!(
+        out.stats.kernel_evaluations, evaluations,
+        "kernel evaluations"
+    );
+    assert_eq!(out.stats.texture_reads, reads, "texture reads");
+    assert!(
+        reads > evaluations,
+        "the scene should exercise reads beyond one per pair ({reads} for {evaluations})"
+    );
     common::finish(ctx);
 }
 

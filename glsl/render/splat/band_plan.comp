@@ -19,7 +19,8 @@ layout(push_constant) uniform BandPlanPush {
     uint slots;    // slots recorded in this submission
 } plan;
 
-// tiles + 3: live fragments, then the frame's kernel evaluations (low and high words)
+// tiles + 5: live fragments, then the frame's kernel evaluations and texture reads (low and
+// high words each)
 layout(std430, binding = 0) readonly buffer Counts { uint counts[]; };
 layout(std430, binding = 1) readonly buffer Offsets { uint offsets[]; }; // tiles + 1: total last
 layout(std430, binding = 2) writeonly buffer BandTable {
@@ -75,5 +76,6 @@ void main() {
         write_slot(k, plan.tiles, plan.tiles);
     }
     band_header[0] = uvec4(bands, status, offsets[plan.tiles], counts[plan.tiles]);
-    band_header[1] = uvec4(counts[plan.tiles + 1u], counts[plan.tiles + 2u], 0u, 0u);
+    band_header[1] = uvec4(counts[plan.tiles + 1u], counts[plan.tiles + 2u],
+                           counts[plan.tiles + 3u], counts[plan.tiles + 4u]);
 }

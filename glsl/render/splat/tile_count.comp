@@ -2,7 +2,8 @@
 // Counts, per screen tile, the fragments whose kernel can reach a pixel of that tile; the
 // element after the last tile counts the live (not merged-away) fragments, the two after it
 // (low and high words) the frame's kernel evaluations: the (pixel, fragment) pairs within
-// reach, what the convolution's cost grows with (`ocular bench` reports them).
+// reach, what the convolution's cost grows with, and the two after those the filtered texture
+// reads the pixel walk makes for them (reads_per_evaluation; `ocular bench` reports both).
 #extension GL_GOOGLE_include_directive : require
 #define FRAME_BINDING 5
 #include "splat.glsl"
@@ -12,14 +13,27 @@ layout(local_size_x = 8, local_size_y = 8) in;
 FRAGMENT_BUFFERS(0, 2, 3, 4, readonly)
 FRAGMENT_LOAD
 layout(std430, binding = 1) buffer Counts { uint counts[]; };
+layout(std430, binding = 6) readonly buffer Field { vec4 field_header[2]; vec4 node_radii[]; };
+#include "field.glsl"
 
 shared uint live_in_group;
 shared uint evaluations_in_group;
+shared uint reads_in_group;
+
+// Adds to the 64-bit sum in counts[at] (low word) and counts[at + 1] (high word): a carry
+// into the high word when the low one wraps.
+void add_wide(uint at, uint value) {
+    uint before = atomicAdd(counts[at], value);
+    if (before + value < before) {
+        atomicAdd(counts[at + 1u], 1u);
+    }
+}
 
 void main() {
     if (gl_LocalInvocationIndex == 0u) {
         live_in_group = 0u;
         evaluations_in_group = 0u;
+        reads_in_group = 0u;
     }
     barrier();
     uvec2 p = gl_GlobalInvocationID.xy;
@@ -29,8 +43,14 @@ void main() {
             atomicAdd(live_in_group, 1u);
             ivec4 pixels = fragment_pixels(f);
             if (pixels.x <= pixels.z) {
-                atomicAdd(evaluations_in_group,
-                          uint(pixels.z - pixels.x + 1) * uint(pixels.w - pixels.y + 1));
+                uint pairs = uint(pixels.z - pixels.x + 1) * uint(pixels.w - pixels.y + 1);
+                uvec4 nodes;
+                vec4 weights;
+                field_corners(f.center, nodes, weights);
+                uint used = uint(weights.x > 0.0) + uint(weights.y > 0.0) + uint(weights.z > 0.0)
+                          + uint(weights.w > 0.0);
+                atomicAdd(evaluations_in_group, pairs);
+                atomicAdd(reads_in_group, pairs * reads_per_evaluation(f, used));
             }
             ivec4 tiles = tiles_of_pixels(pixels);  // the reach once per fragment
             for (int ty = tiles.y; ty <= tiles.w; ty++) {
@@ -44,10 +64,7 @@ void main() {
     uint tiles = frame.tiles_x * frame.tiles_y;
     if (gl_LocalInvocationIndex == 0u && live_in_group > 0u) {
         atomicAdd(counts[tiles], live_in_group);
-        // a 64-bit sum from two words: carry into the high word when the low one wraps
-        uint before = atomicAdd(counts[tiles + 1u], evaluations_in_group);
-        if (before + evaluations_in_group < before) {
-            atomicAdd(counts[tiles + 2u], 1u);
-        }
+        add_wide(tiles + 1u, evaluations_in_group);
+        add_wide(tiles + 3u, reads_in_group);
     }
 }

@@ -37,7 +37,8 @@ pub(super) struct BandSlot<'a> {
 }
 
 /// The band table the GPU plans (glsl/render/splat/band_plan.comp): a 32-byte header (band
-/// count, status, total entries, live fragments, kernel evaluations as two words, two zeros),
+/// count, status, total entries, live fragments, kernel evaluations and texture reads as two words
+/// each),
 /// then 32 bytes per slot, the band's range and the indirect dispatch of the per-tile passes.
 pub(crate) const BAND_TABLE_HEADER_BYTES: u64 = 32;
 const BAND_SLOT_BYTES: u64 = 32;
@@ -64,6 +65,9 @@ pub(crate) struct PlannedBands {
     pub live_fragments: u32,
     /// (pixel, fragment) pairs within reach: the convolution's work.
     pub kernel_evaluations: u64,
+    /// Filtered texture reads the pixel walk makes for them (reads_per_evaluation in
+    /// glsl/common/splat.glsl).
+    pub texture_reads: u64,
 }
 
 impl PlannedBands {
@@ -74,6 +78,7 @@ impl PlannedBands {
             total_entries: header[2],
             live_fragments: header[3],
             kernel_evaluations: u64::from(header[4]) | (u64::from(header[5]) << 32),
+            texture_reads: u64::from(header[6]) | (u64::from(header[7]) << 32),
         }
     }
 

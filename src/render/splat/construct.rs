@@ -236,8 +236,9 @@ impl Splatter {
                 storage,
             )?,
             fragments: fragments::FragmentStore::new(ctx, pixels, per_chunk)?,
-            // per tile, then live fragments and the kernel evaluations' two words
-            counts: Buffer::new(ctx, "tile counts", (tiles + 3) * 4, Residency::Device)?,
+            // per tile, then live fragments and the kernel evaluations' and texture reads' two
+            // words each
+            counts: Buffer::new(ctx, "tile counts", (tiles + 5) * 4, Residency::Device)?,
             cursors: Buffer::new(ctx, "tile cursors", tiles * 4, Residency::Device)?,
             offsets: Buffer::new(ctx, "tile offsets", (tiles + 1) * 4, Residency::Device)?,
             block_sums: Buffer::new(

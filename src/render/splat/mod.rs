@@ -113,6 +113,10 @@ pub struct SplatStats {
     /// (pixel, fragment) pairs within reach: the convolution's work, which level of detail
     /// keeps proportional to the pixels whatever the blur.
     pub kernel_evaluations: u64,
+    /// Filtered texture reads the pixel walk makes for those pairs, at most: a GPU's cost,
+    /// where a pair costs one read (a layer kernel), up to three (the radius levels), four (a
+    /// merged block read where its pixels lie in the wide field) or four times that off axis.
+    pub texture_reads: u64,
     pub max_entries_per_tile: u64,
     pub bands: u32,
     /// Queue submissions, GPU allocations and host↔device bytes this frame cost (the engine's
@@ -482,6 +486,7 @@ impl Splatter {
                     live_fragments: u64::from(planned.live_fragments),
                     list_entries: u64::from(planned.total_entries),
                     kernel_evaluations: planned.kernel_evaluations,
+                    texture_reads: planned.texture_reads,
                     max_entries_per_tile: 0,
                     bands: planned.bands,
                     submissions,
@@ -589,6 +594,7 @@ impl Splatter {
             live_fragments: live,
             list_entries: total,
             kernel_evaluations: planned.kernel_evaluations,
+            texture_reads: planned.texture_reads,
             max_entries_per_tile: counts.iter().copied().max().unwrap_or(0).into(),
             bands: slots,
             submissions,

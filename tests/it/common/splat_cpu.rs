@@ -217,6 +217,47 @@ pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
     (x0 <= x1 && y0 <= y1).then_some([x0, y0, x1, y1])
 }
 
+/// Continuous radius level: quarter pixels up to 2 px, whole pixels beyond (the PSF texture's
+/// levels).
+fn level_of_radius(r: f32) -> f32 {
+    if r <= 2.0 {
+        4.0 * r
+    } else {
+        8.0 + r - 2.0
+    }
+}
+
+/// Filtered texture reads the pixel walk makes for one (pixel, fragment) pair of `f` on axis,
+/// at most: the layer texture's one read, or four for a merged block in the wide field, which
+/// reads where its pixels lie; with the radius levels, one per level the channels' radii span
+/// when that is at most three, else two per channel (one where it sits on a level).
+pub fn reads_per_evaluation(frame: &Frame, f: &Fragment, layered: bool) -> u64 {
+    let radius = f.radius.iter().fold(0.0f32, |a, &b| a.max(b));
+    if layered {
+        let c = frame.cos_theta(f.center[0], f.center[1]);
+        let shrinks = radius > 0.5 && c < 1.0;
+        return if shrinks && f.size > 1 && frame.block_reads {
+            4
+        } else {
+            1
+        };
+    }
+    let levels = f.radius.map(level_of_radius);
+    let base = levels
+        .iter()
+        .map(|l| l.floor())
+        .fold(f32::INFINITY, f32::min);
+    let top = levels.iter().map(|l| l.ceil()).fold(0.0f32, f32::max);
+    if top - base <= 2.0 {
+        1 + (top - base) as u64
+    } else {
+        levels
+            .iter()
+            .map(|l| if l.fract() > 0.0 { 2 } else { 1 })
+            .sum()
+    }
+}
+
 /// Per tile, the sorted (depth bits, fragment index) list.
 pub fn tile_lists(frame: &Frame, fragments: &[Fragment]) -> Vec<Vec<[u32; 2]>> {
     let t = frame.tile as i64;
