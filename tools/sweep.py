@@ -34,7 +34,7 @@ SWEEP = [
     ("Rmax cap", "--rmax-cap", ["4", "8", "16", "64"]),
     ("merge levels", "--merge-levels", ["0", "1", "2", "5"]),
     ("merge min radius", "--merge-min-radius", ["2", "5", "10"]),
-    ("merge blur per block k", "--merge-blur-per-block", ["1", "2", "4"]),
+    ("merge blur per block k", "--merge-blur-per-block", ["0", "1", "2", "4"]),
     # up to 1: colours averaged wherever the blur allows a block (level of detail by blur alone)
     ("merge colour error", "--merge-color-error", ["0.0039", "0.0156", "0.0625", "1"]),
     ("tile size", "--tile-size", ["8", "16", "32"]),
