@@ -13,8 +13,8 @@ layout(push_constant) uniform BandPush {
 } band_push;
 
 // Header (band count, status, total entries, live fragments; kernel evaluations and texture
-// reads, low and high words each), then two uvec4 per slot: (first tile, end tile, first entry, 0) and the
-// indirect dispatch of the per-tile passes.
+// reads, low and high words each), then two uvec4 per slot: (first tile, end tile, first
+// entry, 0) and the indirect dispatch of the per-tile passes.
 layout(std430, binding = BANDS_BINDING) readonly buffer BandTable {
     uvec4 band_header[2];
     uvec4 band_slots[];
