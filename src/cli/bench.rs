@@ -358,13 +358,16 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         outputs.add("--json", path, &["json"])?;
     }
     outputs.probe()?;
-    let splat = args.splat.settings()?;
+    let mut splat = args.splat.settings()?;
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
     let (width, height) = args.size;
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
+    // the white `render` would show this frame at, as the unit of the merge's colour bound
+    splat.merge.white =
+        crate::render::splat::display_white(super::auto_exposure_ev(width, height, &frame.color));
     let mut options = args.cache.kernel_options();
     options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;

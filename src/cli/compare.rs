@@ -12,7 +12,7 @@ use super::raster::parse_frame_size;
 use super::render::load_eye;
 use super::Cli;
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba, Tonemap};
+use crate::image_io::{self, ImageRgba};
 use crate::render::edge_band::edge_band;
 use crate::render::frame::{EyeState, FrameRenderer, KernelOptions, Method, RenderedFrame};
 use crate::render::judge::{exposed, truth_shares, Judge, MethodResult, ViewsConvergence};
@@ -147,7 +147,7 @@ struct Report {
 }
 
 pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
-    let splat = args.splat.settings()?;
+    let mut splat = args.splat.settings()?;
     check_args(args)?;
     // Declared before the outputs so that it is dropped after their temporaries are.
     let maps_created = match &args.maps {
@@ -162,6 +162,10 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let (width, height) = args.size;
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
+    // Compare what a person sees: every image at the input frame's automatic exposure, which
+    // is also the white splat's merge bounds its colour error by.
+    let exposure_ev = super::auto_exposure_ev(width, height, &frame.color);
+    splat.merge.white = crate::render::splat::display_white(exposure_ev);
     let options = kernel_options(args)?;
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
     let mut notes = Vec::new();
@@ -184,9 +188,6 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     };
     let (truth, convergence_images) = render_truth(&at, &mut renderer, args, truth_in, &options)?;
     let rendered = render_methods(&at, &mut renderer, args, truth.method, layers)?;
-    // Compare what a person sees: every image at the input frame's automatic exposure.
-    let exposure_ev =
-        Tonemap::auto_exposure_ev(&ImageRgba::new(width, height, frame.color.clone()));
     let band = edge_band(
         &frame.depth_m,
         (width, height),

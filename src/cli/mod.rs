@@ -184,9 +184,10 @@ pub struct SplatArgs {
         allow_hyphen_values = true
     )]
     pub merge_min_radius: f32,
-    /// The most that averaging one merged block's colours may change any pixel, block by block
-    /// (linear colour units; default 1/1020, a quarter of an 8-bit step, since the blocks along
-    /// a kernel's rim add). A block of side s under blur radius r merges when its parts'
+    /// The most that averaging one merged block's colours may change any pixel, block by block,
+    /// as a fraction of the white the image is shown at (--exposure, else the frame's automatic
+    /// exposure; default 1/16320: a quarter of an 8-bit step shared by the 16 or so blocks a
+    /// kernel's rim crosses, since their errors add). A block of side s under blur radius r merges when its parts'
     /// colours differ by at most 4π·E·(r/s)²: the wider the blur against the block, the
     /// larger the difference that cannot show.
     #[arg(
@@ -338,6 +339,16 @@ pub(crate) fn prepare_kernels(
 
 /// A scene rasterised at t = 0 with the eye state the measuring commands (bench, compare)
 /// use: the scene's focus, and the given pupil, else the scene's, else the seed paper's 5 mm.
+/// The automatic exposure (EV) of a frame's colours: its log-average luminance to middle grey,
+/// the exposure `render` writes a PNG at and `compare` judges at.
+pub(crate) fn auto_exposure_ev(width: u32, height: u32, color: &[[f32; 4]]) -> f32 {
+    crate::image_io::Tonemap::auto_exposure_ev(&crate::image_io::ImageRgba::new(
+        width,
+        height,
+        color.to_vec(),
+    ))
+}
+
 pub(crate) fn measured_scene_frame(
     ctx: &crate::gpu::Context,
     scene: &crate::scene::Scene,

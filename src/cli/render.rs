@@ -459,7 +459,7 @@ fn pupil_asked(args: &RenderArgs) -> PupilAsked<'static> {
 }
 
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
-    let splat = check_args(args)?;
+    let mut splat = check_args(args)?;
     let (eye, physiology) = args.correction.apply(
         &load_eye(&args.eye)?,
         Some((args.age, args.accommodation_line)),
@@ -490,6 +490,8 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     )?;
     let state = EyeState { focus_d, pupil_mm };
     let needs = input.frame.needs(state);
+    splat.merge.white =
+        crate::render::splat::display_white(super::render_output::exposure_ev(args, &input));
     if args.method == Method::Views {
         let scene = Scene::load(args.scene.as_deref().unwrap_or("primitives"))?;
         let frame = super::occlusion::render_views(

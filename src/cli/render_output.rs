@@ -156,15 +156,21 @@ fn write_image(
         TonemapArg::Clamp => TonemapMode::Clamp,
         TonemapArg::Reinhard => TonemapMode::Reinhard,
     };
-    // Expose for the scene, not the blurred result, so that eyes compare at one exposure.
-    let exposure_ev = args.exposure.unwrap_or_else(|| {
+    let exposure_ev = exposure_ev(args, input);
+    image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })
+}
+
+/// The exposure the image is shown at: --exposure, else the input frame's automatic one.
+/// Exposed for the scene, not the blurred result, so that eyes compare at one exposure; an EXR
+/// is judged at it too, and splat's merge bounds its colour error by the white it gives.
+pub(super) fn exposure_ev(args: &RenderArgs, input: &Input) -> f32 {
+    args.exposure.unwrap_or_else(|| {
         Tonemap::auto_exposure_ev(&ImageRgba::new(
             input.frame.width,
             input.frame.height,
             input.frame.color.clone(),
         ))
-    });
-    image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })
+    })
 }
 
 /// Where the eye focused, in words: the distance, and the limit it met.

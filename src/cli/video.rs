@@ -301,6 +301,13 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             args.exposure.is_none(),
         )?;
         exposure_ev = exposure_ev.or(auto_ev);
+        // The merge's colour bound is a fraction of the white the frames are shown at: frame
+        // 0's automatic exposure unless --exposure fixes it (EXR frames too, where it is how
+        // they would be viewed).
+        let mut splat = SplatSettings::default();
+        if let Some(ev) = exposure_ev {
+            splat.merge.white = crate::render::splat::display_white(ev);
+        }
         for (_, eye) in &eyes {
             let kernels = super::prepare_kernels(eye, &needs, &options)?;
             renderers.push(FrameRenderer::new(
@@ -308,7 +315,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
                 eye.clone(),
                 kernels,
                 options.settings.clone(),
-                SplatSettings::default(),
+                splat,
             ));
         }
     }

@@ -161,6 +161,15 @@ impl PyRenderer {
         let prepared = prepared.as_mut().expect("prepared above");
         let focus_reached_d = prepared.focus_reached_d;
         let renderer = &mut prepared.renderer;
+        // The merge's colour bound is a fraction of the white the frame is shown at: its
+        // automatic exposure, as `ocular render` writes it.
+        renderer.set_display_white(crate::render::splat::display_white(
+            crate::image_io::Tonemap::auto_exposure_ev(&crate::image_io::ImageRgba::new(
+                frame.width,
+                frame.height,
+                frame.color.clone(),
+            )),
+        ));
         let rendered = match (scene, rasterizer.as_mut(), loaded.as_ref()) {
             (Some((_, time_s)), Some(raster), Some((_, scene))) if o.method == Method::Splat => {
                 let gap_d = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D;

@@ -385,6 +385,18 @@ impl FrameRenderer {
         &self.eye
     }
 
+    /// The value the frames will be shown as white (`MergeSettings::white`): the unit of the
+    /// merge's colour bound. A non-positive or non-finite value leaves it unchanged.
+    pub fn set_display_white(&mut self, white: f32) {
+        if !(white.is_finite() && white > 0.0) {
+            return;
+        }
+        self.splat_settings.merge.white = white;
+        if let Some(s) = self.splatter.as_mut() {
+            s.set_display_white(white);
+        }
+    }
+
     pub fn kernels(&self) -> &PreparedKernels {
         &self.kernels
     }

@@ -121,8 +121,11 @@ fn a_plane_through_the_four_eyes_is_its_convolution() {
                 db_truth >= 60.0,
                 "{name} at {distance_m} m: reference {db_truth:.1} dB"
             );
+            // Measured 67.4–73.4 dB. Merging with the colour bound at 1/1020 of white (the
+            // previous default in display units) scores 55.7–73.6 and fails it: a texture whose
+            // period is near the block side adds the blocks' errors along the kernel's rim.
             assert!(
-                db_splat >= 45.0,
+                db_splat >= 62.0,
                 "{name} at {distance_m} m: splat {db_splat:.1} dB"
             );
         }

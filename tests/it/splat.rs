@@ -660,6 +660,68 @@ fn merging_scene() -> Scene {
     })
 }
 
+/// The colour rule's ε is a fraction of the white the image is shown at, not of 1: a frame in
+/// cd/m² (a scene's white lies at hundreds of them) merges as the same frame in display units
+/// does. Scaled by 1024 (a power of two, so every sum scales exactly) with the white scaled
+/// alike, the merge decisions and the image are the same; the white left at 1 (the rule applied
+/// in the frame's own units, as before) merges fewer blocks.
+#[test]
+fn the_colour_rule_is_relative_to_the_display_white() {
+    let ctx = common::gpu();
+    let eye = SyntheticEye::new(0.2, 5.0);
+    let (objects, max_radius) = axis_for(&eye, 0.0, 3.0, 13);
+    let grid = eye.grid(objects, max_radius, &[4.0], 90);
+    let scene = merging_scene();
+    const SCALE: f32 = 1024.0;
+    let bright = Scene {
+        color: scene
+            .color
+            .iter()
+            .map(|p| [p[0] * SCALE, p[1] * SCALE, p[2] * SCALE, p[3]])
+            .collect(),
+        depth: scene.depth.clone(),
+        ..scene
+    };
+    let scene = merging_scene();
+    let settings = |white: f32| SplatSettings {
+        merge: MergeSettings {
+            levels: 2,
+            blur_per_block: 1.0,
+            color_error: 1.0 / 255.0,
+            white,
+            ..MergeSettings::default()
+        },
+        ..SplatSettings::default()
+    };
+    let plain = splat(&ctx, &grid, settings(1.0), &scene, false);
+    let scaled = splat(&ctx, &grid, settings(SCALE), &bright, false);
+    let unscaled_rule = splat(&ctx, &grid, settings(1.0), &bright, false);
+    let merged = |o: &SplatOutput| o.stats.live_fragments;
+    assert!(
+        merged(&plain) < 96 * 64,
+        "the scene should merge some blocks ({} live fragments)",
+        merged(&plain)
+    );
+    assert_eq!(
+        merged(&scaled),
+        merged(&plain),
+        "same decisions, white scaled"
+    );
+    let worst = plain
+        .color
+        .iter()
+        .zip(&scaled.color)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] * SCALE - b[c]).abs() / SCALE))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-6, "images differ by {worst} of white");
+    assert!(
+        merged(&unscaled_rule) > merged(&plain),
+        "the negative control: ε taken in the frame's units merges fewer blocks ({} vs {})",
+        merged(&unscaled_rule),
+        merged(&plain)
+    );
+}
+
 #[test]
 fn every_pass_matches_its_cpu_step() {
     let ctx = common::gpu();

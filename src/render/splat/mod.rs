@@ -45,7 +45,9 @@ use crate::psf::kernels::KernelGrid;
 use bands::{plan_bands, BandPush, BandSlot, PlannedBands};
 pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
-pub use settings::{ConvolveWalk, MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON};
+pub use settings::{
+    display_white, ConvolveWalk, MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON,
+};
 use uniform::FrameBlock;
 pub(crate) use uniform::FrameUniform;
 pub use uniform::FRAME_UNIFORM_BYTES;
@@ -291,6 +293,12 @@ impl Splatter {
 
     pub fn settings(&self) -> &SplatSettings {
         &self.settings
+    }
+
+    /// The value the image will be shown as white (`MergeSettings::white`), from the next
+    /// frame on.
+    pub fn set_display_white(&mut self, white: f32) {
+        self.settings.merge.white = white;
     }
 
     /// The PSF texture as the convolution pass samples it (for inspection and tests).

@@ -69,7 +69,8 @@ impl Splatter {
             dioptre_min: self.grid.objects.min_d as f32,
             dioptre_step: self.grid.objects.step_d as f32,
             merge_min_radius: merge.min_radius_px,
-            merge_color_error: merge.color_error,
+            // in the frame's own units: a fraction of the value shown as white
+            merge_color_error: merge.color_error * merge.white,
             merge_dioptre_tolerance: merge.dioptre_tolerance,
             focal_px,
             group_tolerance_d: self.settings.blend.group_tolerance_d,

@@ -142,7 +142,10 @@ pub fn merge_level(
             }
             // 4π·ε·(r/s)², in merge.comp's order of operations.
             let blur_per_side = r_min / size as f32;
-            let color_bound = 12.566371f32 * settings.color_error * blur_per_side * blur_per_side;
+            let color_bound = 12.566371f32
+                * (settings.color_error * settings.white)
+                * blur_per_side
+                * blur_per_side;
             let mut ok = true;
             let mut spread = 0.0f32;
             for a in 0..4 {

@@ -15,6 +15,7 @@ pub const NO_MERGE: MergeSettings = MergeSettings {
     blur_per_block: 0.0,
     min_radius_px: 5.0,
     color_error: MergeSettings::DEFAULT_COLOR_ERROR,
+    white: 1.0,
     dioptre_tolerance: 0.01,
     scale_error_px: MergeSettings::DEFAULT_SCALE_ERROR_PX,
 };
