@@ -385,6 +385,8 @@ fn kernel_options(args: &CompareArgs) -> Result<KernelOptions> {
     let mut options = args.cache.kernel_options();
     options.reference_axes.objects =
         crate::psf::kernels::DioptreAxis::spanning(0.125, 10.125, args.object_samples);
+    // --object-samples is the axis measured, at every size
+    options.objects_follow_screen = false;
     options.settings.max_radius_cap = args.rmax_cap;
     options.settings.max_beta_degree = args.beta_degree;
     options.settings.sample_um = args.sample_um;

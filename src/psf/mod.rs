@@ -47,7 +47,7 @@ pub use kernels::{
     kernel_side, level_block_radius, level_count, level_of_radius, level_radius_px, DioptreAxis,
     KernelGrid, KernelSet,
 };
-pub use plan::{plan_for_scene, SceneNeeds};
+pub use plan::{objects_for_screen, plan_for_scene, SceneNeeds, OBJECT_STEP_BLUR_PX};
 // Kernels across the visual field.
 pub use field::{field_column, frame_half_field_deg, FieldAxes};
 pub use field_plan::{plan_field_axes, Probe, FIELD_TOLERANCE_UM};

@@ -37,6 +37,34 @@ pub const OBJECT_MARGIN_SAMPLES: i64 = 1;
 /// by the reference axis points that bracket them (the runtime interpolates between them).
 pub const EXACT_VALUES: usize = 2;
 
+/// The most (px) that the geometric blur radius may change between neighbouring object
+/// samples of the default axis: a quarter pixel, the radius levels' own step below 2 px. The
+/// splat's layer kernels (one texture read per pixel and fragment) replace the levels only
+/// where neighbouring distances' radii lie within one level of each other, so an axis coarser
+/// than this near focus falls back to the levels (up to six reads).
+pub const OBJECT_STEP_BLUR_PX: f64 = 0.25;
+
+/// `objects` with its step halved (its samples kept, so its phase too) until one step moves
+/// the geometric blur radius, (pupil/2)·step·(px per radian), by at most
+/// [`OBJECT_STEP_BLUR_PX`] at `pupil_mm`: the 1/16 D default at 3840×2160 and a 60° field
+/// moves it by 0.29 px at a 5 mm pupil, and is halved there; up to 1920×1080 it is kept. At
+/// most three halvings (1/128 D from the default).
+pub fn objects_for_screen(objects: DioptreAxis, screen: &Screen, pupil_mm: f64) -> DioptreAxis {
+    let blur_px_per_d = 0.5e-3 * pupil_mm * screen.px_per_radian();
+    let mut axis = objects;
+    for _ in 0..3 {
+        if !(blur_px_per_d * axis.step_d > OBJECT_STEP_BLUR_PX && axis.count > 1) {
+            break;
+        }
+        axis = DioptreAxis {
+            min_d: axis.min_d,
+            step_d: 0.5 * axis.step_d,
+            count: 2 * axis.count - 1,
+        };
+    }
+    axis
+}
+
 /// Plans against `reference` (usually [`GridAxes::default`]): objects keep its spacing and
 /// phase, so planned sets coincide with the reference grid's samples.
 pub fn plan_for_scene(needs: &SceneNeeds, reference: &GridAxes) -> Result<Plan, String> {

@@ -121,7 +121,7 @@ impl PyRenderer {
             splat: SplatSettings::default(),
         };
         let needs = frame.needs(state);
-        let planned = crate::psf::plan::plan_for_scene(&needs, &options.reference_axes)
+        let planned = crate::psf::plan::plan_for_scene(&needs, &options.reference_for(&needs))
             .map_err(Error::input)?;
         let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
         let reusable = inner

@@ -70,6 +70,10 @@ pub struct KernelOptions {
     /// Off-axis kernels for frames this wide (pixels): one grid per direction of a field
     /// lattice planned from the frame. None: the on-axis PSF everywhere.
     pub field_width_px: Option<u32>,
+    /// On axis, the object step of `reference_axes` is halved where the frame's pixel scale
+    /// needs it (`psf::plan::objects_for_screen`), so that the splat's layer kernels hold at
+    /// 4K. Off for a caller that sets its own object axis to measure it (`compare`).
+    pub objects_follow_screen: bool,
 }
 
 /// A progress callback: (stage, done, total).
@@ -83,6 +87,7 @@ impl std::fmt::Debug for KernelOptions {
             .field("cache_dir", &self.cache_dir)
             .field("progress", &self.progress.is_some())
             .field("field_width_px", &self.field_width_px)
+            .field("objects_follow_screen", &self.objects_follow_screen)
             .finish()
     }
 }
@@ -95,7 +100,23 @@ impl Default for KernelOptions {
             cache_dir: cache::default_cache_dir(),
             progress: None,
             field_width_px: None,
+            objects_follow_screen: true,
         }
+    }
+}
+
+impl KernelOptions {
+    /// The axes a frame with `needs` is planned against: `reference_axes`, on axis with its
+    /// object step refined for the frame's pixel scale and largest pupil where
+    /// `objects_follow_screen`.
+    pub fn reference_for(&self, needs: &SceneNeeds) -> GridAxes {
+        let mut axes = self.reference_axes.clone();
+        if self.objects_follow_screen && self.field_width_px.is_none() {
+            let pupil_mm = needs.pupils_mm.iter().copied().fold(0.0, f64::max);
+            axes.objects =
+                crate::psf::plan::objects_for_screen(axes.objects, &needs.screen, pupil_mm);
+        }
+        axes
     }
 }
 
@@ -242,7 +263,7 @@ pub fn prepare_kernels(
     options: &KernelOptions,
 ) -> Result<PreparedKernels> {
     let started = Instant::now();
-    let plan = plan_for_scene(needs, &options.reference_axes).map_err(Error::input)?;
+    let plan = plan_for_scene(needs, &options.reference_for(needs)).map_err(Error::input)?;
     let progress = |stage: Stage, done: usize, total: usize| {
         if let Some(hook) = &options.progress {
             hook(stage, done, total);

@@ -73,6 +73,8 @@ fn render_on(
         cache_dir: cache(),
         progress: None,
         reference_axes: axes,
+        // the axis given is the one measured, at every pixel scale
+        objects_follow_screen: false,
         ..KernelOptions::default()
     };
     let screen = Screen {

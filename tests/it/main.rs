@@ -36,6 +36,7 @@ mod layered_inputs;
 mod layers;
 mod metrics;
 mod metrics_small;
+mod object_axis;
 mod off_axis_kernels;
 mod off_axis_optics;
 mod off_axis_runtime;
