@@ -22,6 +22,8 @@ pub(super) struct Options {
     pub(super) method: Method,
     pub(super) layers: u32,
     pub(super) off_axis: bool,
+    /// The exposure the image will be shown at (EV; None: the frame's automatic one).
+    pub(super) exposure_ev: Option<f64>,
 }
 
 fn parse_method(name: &str) -> Result<Method> {
@@ -49,6 +51,7 @@ pub(super) fn options(
     method: &str,
     layers: u32,
     off_axis: bool,
+    exposure_ev: Option<f64>,
 ) -> Result<Options> {
     let given = [focus_m.is_some(), focus_d.is_some(), focus_at.is_some()];
     if given.iter().filter(|g| **g).count() > 1 {
@@ -92,6 +95,13 @@ pub(super) fn options(
              on-axis PSF)",
         ));
     }
+    if let Some(ev) = exposure_ev {
+        if !(ev.is_finite() && ev.abs() <= 64.0) {
+            return Err(Error::input(format!(
+                "exposure_ev {ev} must be a number of EV in [-64, 64]"
+            )));
+        }
+    }
     Ok(Options {
         focus_m,
         focus_d,
@@ -102,6 +112,7 @@ pub(super) fn options(
         method,
         layers,
         off_axis,
+        exposure_ev,
     })
 }
 

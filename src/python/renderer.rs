@@ -161,15 +161,19 @@ impl PyRenderer {
         let prepared = prepared.as_mut().expect("prepared above");
         let focus_reached_d = prepared.focus_reached_d;
         let renderer = &mut prepared.renderer;
-        // The merge's colour bound is a fraction of the white the frame is shown at: its
-        // automatic exposure, as `ocular render` writes it.
-        renderer.set_display_white(crate::render::splat::display_white(
-            crate::image_io::Tonemap::auto_exposure_ev(&crate::image_io::ImageRgba::new(
-                frame.width,
-                frame.height,
-                frame.color.clone(),
-            )),
-        ));
+        // The merge's colour bound is a fraction of the white the frame is shown at: the
+        // exposure given, else its automatic one, as `ocular render` writes it.
+        let exposure_ev = o.exposure_ev.map_or_else(
+            || {
+                crate::image_io::Tonemap::auto_exposure_ev(&crate::image_io::ImageRgba::new(
+                    frame.width,
+                    frame.height,
+                    frame.color.clone(),
+                ))
+            },
+            |ev| ev as f32,
+        );
+        renderer.set_display_white(crate::render::splat::display_white(exposure_ev));
         let rendered = match (scene, rasterizer.as_mut(), loaded.as_ref()) {
             (Some((_, time_s)), Some(raster), Some((_, scene))) if o.method == Method::Splat => {
                 let gap_d = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D;
@@ -329,7 +333,7 @@ impl PyRenderer {
 
     /// `color` (H, W, 3) float32 linear RGB and `depth` (H, W) float32 metres along the view
     /// axis (0 or inf: background) as `eye` sees them; returns (H, W, 3) float32.
-    #[pyo3(signature = (eye, color, depth, *, fov_y_deg, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false))]
+    #[pyo3(signature = (eye, color, depth, *, fov_y_deg, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -347,6 +351,7 @@ impl PyRenderer {
         method: &str,
         layers: u32,
         off_axis: bool,
+        exposure_ev: Option<f64>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let o = options(
             focus_m,
@@ -358,6 +363,7 @@ impl PyRenderer {
             method,
             layers,
             off_axis,
+            exposure_ev,
         )
         .map_err(super::to_py)?;
         crate::limits::FOV_Y_DEG
@@ -386,7 +392,7 @@ impl PyRenderer {
 
     /// A shipped scene (`scenes()`) or a scene .toml file as `eye` sees it; returns
     /// (H, W, 3) float32 linear RGB. Focus and pupil default to the scene's.
-    #[pyo3(signature = (scene, eye, *, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false))]
+    #[pyo3(signature = (scene, eye, *, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None))]
     #[allow(clippy::too_many_arguments)]
     fn render_scene<'py>(
         &self,
@@ -404,6 +410,7 @@ impl PyRenderer {
         method: &str,
         layers: u32,
         off_axis: bool,
+        exposure_ev: Option<f64>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let o = options(
             focus_m,
@@ -415,6 +422,7 @@ impl PyRenderer {
             method,
             layers,
             off_axis,
+            exposure_ev,
         )
         .map_err(super::to_py)?;
         let eye = eye.eye.clone();

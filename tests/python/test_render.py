@@ -220,3 +220,26 @@ def test_default_focus_and_pupil_render_as_the_cli_does(tmp_path, cli, kernel_ca
     assert r.last_frame["pupil_mm"] > 5.0
     from_cli = oc.read_exr(out)
     assert np.abs(ours - from_cli).max() <= 1e-6 * float(np.abs(from_cli).max())
+
+
+def test_the_merge_bound_follows_the_white_the_image_is_shown_at(renderer):
+    # A smooth texture on a plane 3.75 D out of focus, shown with white at 64 cd/m², where the
+    # colour rule lets blocks merge. The same frame ×1024 shown 10 EV darker is the
+    # same picture: the merge decisions and so the image scale exactly. Kept at the first white
+    # (the rule applied in the frame's own units) the bright frame merges fewer blocks and
+    # renders differently.
+    y, x = np.mgrid[0:H, 0:W].astype(np.float32)
+    color = np.stack([50 + 10 * np.sin(0.2 * x), 40 + 10 * np.cos(0.15 * y),
+                      30 + 10 * np.sin(0.1 * (x + y))], axis=-1).astype(np.float32)
+    depth = np.full((H, W), 0.25, np.float32)
+    eye = oc.Eye.preset("healthy")
+    args = dict(fov_y_deg=FOV, focus_m=4.0, pupil_mm=5.0)
+    with pytest.warns(UserWarning):
+        base = renderer.render(eye, color, depth, exposure_ev=-6.0, **args)
+        scaled = renderer.render(eye, color * 1024, depth, exposure_ev=-16.0, **args)
+        same_white = renderer.render(eye, color * 1024, depth, exposure_ev=-6.0, **args)
+    assert np.abs(scaled / 1024 - base).max() <= 1e-6 * np.abs(base).max()
+    # merging moves a pixel by a fraction of an 8-bit step: measured 6.7e-5 of the brightest
+    assert np.abs(same_white / 1024 - base).max() > 1e-5 * np.abs(base).max()
+    with pytest.raises(ValueError, match=r"^exposure_ev NaN must be a number of EV in \[-64, 64\]$"):
+        renderer.render(eye, color, depth, exposure_ev=float("nan"), **args)

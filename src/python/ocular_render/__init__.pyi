@@ -144,6 +144,7 @@ class Renderer:
         method: _Method = "splat",
         layers: int = 1,
         off_axis: bool = False,
+        exposure_ev: Optional[float] = None,
     ) -> _F32:
         """color (H, W, 3) or (L, H, W, 3) float32, depth (H, W) or (L, H, W) float32 metres
         → (H, W, 3) float32, as `ocular render --color --depth` renders them."""
@@ -163,6 +164,7 @@ class Renderer:
         method: _Method = "splat",
         layers: int = 1,
         off_axis: bool = False,
+        exposure_ev: Optional[float] = None,
     ) -> _F32:
         """A shipped scene or scene .toml file as the eye sees it (size is (W, H))."""
     def rasterize(
