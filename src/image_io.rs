@@ -45,9 +45,14 @@ impl Tonemap {
     /// Exposure that maps the image's log-average luminance to middle grey (0.18): a sensible
     /// default for luminance-calibrated frames whose values are in cd/m².
     pub fn auto_exposure_ev(image: &ImageRgba) -> f32 {
+        Tonemap::auto_exposure_ev_of(&image.pixels)
+    }
+
+    /// [`Tonemap::auto_exposure_ev`] of bare pixels (linear RGBA, alpha ignored).
+    pub fn auto_exposure_ev_of(pixels: &[[f32; 4]]) -> f32 {
         let mut sum = 0.0f64;
         let mut count = 0usize;
-        for p in &image.pixels {
+        for p in pixels {
             let y = luminance([p[0], p[1], p[2]]);
             if y.is_finite() && y > 0.0 {
                 sum += f64::from(y.max(1e-4)).ln();

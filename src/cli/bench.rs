@@ -366,8 +366,9 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
     // the white `render` would show this frame at, as the unit of the merge's colour bound
-    splat.merge.white =
-        crate::render::splat::display_white(super::auto_exposure_ev(width, height, &frame.color));
+    splat.merge.white = crate::render::splat::display_white(
+        crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color),
+    );
     let mut options = args.cache.kernel_options();
     options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;

@@ -164,7 +164,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
     // Compare what a person sees: every image at the input frame's automatic exposure, which
     // is also the white splat's merge bounds its colour error by.
-    let exposure_ev = super::auto_exposure_ev(width, height, &frame.color);
+    let exposure_ev = crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color);
     splat.merge.white = crate::render::splat::display_white(exposure_ev);
     let options = kernel_options(args)?;
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;

@@ -339,16 +339,6 @@ pub(crate) fn prepare_kernels(
 
 /// A scene rasterised at t = 0 with the eye state the measuring commands (bench, compare)
 /// use: the scene's focus, and the given pupil, else the scene's, else the seed paper's 5 mm.
-/// The automatic exposure (EV) of a frame's colours: its log-average luminance to middle grey,
-/// the exposure `render` writes a PNG at and `compare` judges at.
-pub(crate) fn auto_exposure_ev(width: u32, height: u32, color: &[[f32; 4]]) -> f32 {
-    crate::image_io::Tonemap::auto_exposure_ev(&crate::image_io::ImageRgba::new(
-        width,
-        height,
-        color.to_vec(),
-    ))
-}
-
 pub(crate) fn measured_scene_frame(
     ctx: &crate::gpu::Context,
     scene: &crate::scene::Scene,

@@ -164,13 +164,8 @@ fn write_image(
 /// Exposed for the scene, not the blurred result, so that eyes compare at one exposure; an EXR
 /// is judged at it too, and splat's merge bounds its colour error by the white it gives.
 pub(super) fn exposure_ev(args: &RenderArgs, input: &Input) -> f32 {
-    args.exposure.unwrap_or_else(|| {
-        Tonemap::auto_exposure_ev(&ImageRgba::new(
-            input.frame.width,
-            input.frame.height,
-            input.frame.color.clone(),
-        ))
-    })
+    args.exposure
+        .unwrap_or_else(|| Tonemap::auto_exposure_ev_of(&input.frame.color))
 }
 
 /// Where the eye focused, in words: the distance, and the limit it met.

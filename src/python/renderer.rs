@@ -164,13 +164,7 @@ impl PyRenderer {
         // The merge's colour bound is a fraction of the white the frame is shown at: the
         // exposure given, else its automatic one, as `ocular render` writes it.
         let exposure_ev = o.exposure_ev.map_or_else(
-            || {
-                crate::image_io::Tonemap::auto_exposure_ev(&crate::image_io::ImageRgba::new(
-                    frame.width,
-                    frame.height,
-                    frame.color.clone(),
-                ))
-            },
+            || crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color),
             |ev| ev as f32,
         );
         renderer.set_display_white(crate::render::splat::display_white(exposure_ev));

@@ -73,9 +73,7 @@ pub fn animation_needs(
         let state = timeline.state(i);
         let frame = rasterizer.render(ctx, &state, width, height)?;
         if auto_exposure && exposure_ev.is_none() {
-            exposure_ev = Some(crate::image_io::Tonemap::auto_exposure_ev(
-                &crate::image_io::ImageRgba::new(width, height, frame.color.clone()),
-            ));
+            exposure_ev = Some(crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color));
         }
         ranges.push(dioptre_range(
             &frame.depth_m,

@@ -5,12 +5,13 @@
 //! scale of 3840×2160 at 60° and is small enough for lavapipe.
 
 use crate::common;
+use common::frames::frame_renderer;
 
 use ocular::eye::resolve;
 use ocular::psf::{objects_for_screen, DioptreAxis, GridAxes, Screen, OBJECT_STEP_BLUR_PX};
 use ocular::render::splat::FrameInput;
+use ocular::render::Method;
 use ocular::render::{dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions};
-use ocular::render::{FrameRenderer, Method};
 
 const W: usize = 160;
 const H: usize = 90;
@@ -113,13 +114,7 @@ fn at_the_pixel_scale_of_4k_the_layer_kernels_hold() {
         };
         let kernels = prepare_kernels(&eye, &needs, &options).unwrap();
         let step_d = kernels.grid.objects.step_d;
-        let mut renderer = FrameRenderer::new(
-            &ctx,
-            eye.clone(),
-            kernels,
-            options.settings.clone(),
-            ocular::render::splat::SplatSettings::default(),
-        );
+        let mut renderer = frame_renderer(&ctx, eye.clone(), kernels, &options);
         let splat = renderer.render(&input, state, Method::Splat).unwrap();
         let truth = renderer.render(&input, state, Method::Reference).unwrap();
         let db = common::pixels::psnr(&splat.color, &truth.color);
