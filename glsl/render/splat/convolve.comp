@@ -50,6 +50,9 @@ layout(constant_id = 1) const uint OFF_AXIS = 0u;
 // 1: each object distance's own kernel from the layer texture, one read for all channels
 // (frame.layered says the same; a pipeline of its own, so each carries only its reads).
 layout(constant_id = 3) const uint LAYERED = 0u;
+// 0: the frame has no hidden layers (pupil_share is 1): a pipeline of its own, like the
+// visits walk's.
+layout(constant_id = 4) const uint HIDDEN = 1u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
@@ -235,7 +238,8 @@ void main() {
                 } else {
                     w = fragment_weight(j, f, d);
                 }
-                vec3 g = pupil_share(f.size, f.radius, pupil_inner(f.size), d);
+                vec3 g = HIDDEN == 0u ? vec3(1.0)
+                                      : pupil_share(f.size, f.radius, pupil_inner(f.size), d);
                 if (grouped) {
                     if (last[q] >= 0.0 && abs(f.dioptre - last[q]) > frame.group_tolerance_d) {
                         close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);

@@ -48,6 +48,9 @@ layout(constant_id = 2) const uint PER_FRAGMENT_BLEND = 0u;
 // 1: each object distance's own kernel from the layer texture: one read per visit, all
 // channels (a pipeline of its own: a CPU implementation pays for every read it contains).
 layout(constant_id = 3) const uint LAYERED = 0u;
+// 0: the frame has no hidden layers, so no fragment's light is partly blocked (pupil_share is
+// 1): a pipeline of its own, since a CPU implementation pays for pupil_share on every visit.
+layout(constant_id = 4) const uint HIDDEN = 1u;
 const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 const bool grouped = PER_FRAGMENT_BLEND == 0u;
@@ -252,10 +255,18 @@ vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2
 
 // Per-channel kernel weight of slot j at screen offset d: the local scale's kernel offset, the
 // reads, off axis the four field nodes mixed bilinearly.
-vec3 slot_weight(uint j, vec2 d, vec2 extent) {
+vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
     vec4 s = slot_scale[j];
     vec2 k = kernel_offset(s.xy, s.zw, d);
-    float layer = slot_reach[j].w;
+    if (LAYERED != 0u && grouped) {
+        // The layer kernels with the depth groups: one read, one coefficient for every channel
+        // (the plan's, in the read's slot) and no weight after it, so slot_gb is not loaded: a
+        // CPU implementation pays for each shared-memory load of every visit (two of seven
+        // took 12 % of colonnade's convolution on lavapipe). The same products as one_read's.
+        vec4 at = slot_read[READS * j];
+        vec2 q = clamp(k + slot_read[READS * j + 1u].xy, vec2(-at.z), vec2(at.z));
+        return at.w * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
+    }
     vec4 gb0 = slot_gb[2u * j];
     vec4 gb1 = slot_gb[2u * j + 1u];
     vec3 w;
@@ -417,10 +428,11 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
                 if (abs(d.x) <= g.z && abs(d.y) <= g.z) {
-                    vec3 w = slot_weight(j, d, extent.xy);
+                    vec3 w = slot_weight(j, d, extent.xy, g.w);
                     uvec4 hidden = slot_hidden[j];
-                    vec3 share = pupil_share(hidden.x, uintBitsToFloat(hidden.yzw),
-                                             pupil_inner(hidden.x), d);
+                    vec3 share = HIDDEN == 0u ? vec3(1.0)
+                        : pupil_share(hidden.x, uintBitsToFloat(hidden.yzw),
+                                      pupil_inner(hidden.x), d);
                     if (grouped) {
                         if (last[q] >= 0.0 && abs(color.w - last[q]) > frame.group_tolerance_d) {
                             close_group(C[q], A[q], Cg[q], Ag[q], Gg[q]);

@@ -8,18 +8,21 @@ use super::passes::PassConfig;
 use super::Resources;
 
 pub(super) struct ConvolvePass {
-    pipeline: ComputePipeline,
-    /// On axis, the same walk reading the layer texture (one read per pixel and fragment).
-    layered: Option<ComputePipeline>,
+    /// Indexed by whether the frame has hidden layers (`HIDDEN`: without them no fragment's
+    /// light is partly blocked, and the walk skips `pupil_share`).
+    pipeline: [ComputePipeline; 2],
+    /// On axis, the same walks reading the layer texture (one read per pixel and fragment).
+    layered: Option<[ComputePipeline; 2]>,
 }
 
 impl super::passes::Pass for ConvolvePass {
     /// Off axis the four-node kernels of a field lattice (src/render/splat/field.rs); the
     /// per-fragment blend is a pipeline constant of the visits walk (convolve.comp reads it
     /// from the frame block); `visit_slots` picks the walk for CPU implementations
-    /// (glsl/render/splat/convolve_visits.comp says why).
+    /// (glsl/render/splat/convolve_visits.comp says why). Pipelines compile on first use, so
+    /// the variants a run never records cost nothing.
     fn new(ctx: &Context, config: &PassConfig) -> GpuResult<Self> {
-        let build = |layered: bool| {
+        let build = |layered: bool, hidden: bool| {
             let builder = if config.visit_slots {
                 ComputePipeline::builder(
                     "convolve",
@@ -34,14 +37,15 @@ impl super::passes::Pass for ConvolvePass {
                 .specialize(0, config.tile_size)
                 .specialize(1, u32::from(config.off_axis))
                 .specialize(3, u32::from(layered))
+                .specialize(4, u32::from(hidden))
                 .build(ctx)
         };
         Ok(ConvolvePass {
-            pipeline: build(false)?,
+            pipeline: [build(false, false)?, build(false, true)?],
             layered: if config.off_axis {
                 None
             } else {
-                Some(build(true)?)
+                Some([build(true, false)?, build(true, true)?])
             },
         })
     }
@@ -57,9 +61,10 @@ impl ConvolvePass {
         band: &BandSlot<'_>,
     ) -> GpuResult<()> {
         let table = &r.frame.band_table;
+        let hidden = usize::from(r.block.values.layers > 1);
         let pipeline = match (&self.layered, r.block.values.layered) {
-            (Some(layered), 1) => layered,
-            _ => &self.pipeline,
+            (Some(layered), 1) => &layered[hidden],
+            _ => &self.pipeline[hidden],
         };
         rec.compute(pipeline)
             .read("psf_texture", (r.texture, r.sampler))
