@@ -193,6 +193,12 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     }
     slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
+    if (LAYERED != 0u) {
+        // The third read's place, unused when layered, holds what the grouped visit loads: the
+        // read's kind (its point and bound are in registers: layer_read_of), its coefficient
+        // and its offset.
+        slot_read[READS * j + 2u] = vec4(float(layer_kind(block_size(f))), coef[0].r, 0.0, 0.0);
+    }
 }
 
 // Layered, a merged block in the wide field (block_reads in splat.glsl) takes four slots
@@ -218,8 +224,39 @@ void fill_wide_block_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach,
     }
     slot_read[READS * j].w = share * plan.coefs[0].r;
     slot_read[READS * j + 1u] = vec4(shift, 0.0, 0.0);
+    slot_read[READS * j + 2u] =
+        vec4(size == 2u ? 0.0 : float(SAT_KIND), share * plan.coefs[0].r, shift);
     vec4 gb = slot_gb[2u * j];
     slot_gb[2u * j] = vec4(share * gb.xy, gb.zw);
+}
+
+// Layered: each read kind's texture point and bound (kinds 0–4: layer_point, layer_bound;
+// SAT_KIND: the summed-area table's corner 0, the table's half-width), loaded once per
+// invocation (walk_slots) and picked per visit by selects, which cost a CPU implementation far
+// less than a shared-memory load.
+vec3 kind_read0;
+vec3 kind_read1;
+vec3 kind_read2;
+vec3 kind_read3;
+vec3 kind_read4;
+vec3 kind_read5;
+
+void load_kind_reads() {
+    kind_read0 = vec3(layer_point(0u), layer_bound(0u));
+    kind_read1 = vec3(layer_point(1u), layer_bound(1u));
+    kind_read2 = vec3(layer_point(2u), layer_bound(2u));
+    kind_read3 = vec3(layer_point(3u), layer_bound(3u));
+    kind_read4 = vec3(layer_point(4u), layer_bound(4u));
+    kind_read5 = vec3(sat_point(), float(layer_header.w) + 0.5);
+}
+
+vec3 layer_read_of(float kind) {
+    vec3 at = kind_read0;
+    at = kind > 0.5 ? kind_read1 : at;
+    at = kind > 1.5 ? kind_read2 : at;
+    at = kind > 2.5 ? kind_read3 : at;
+    at = kind > 3.5 ? kind_read4 : at;
+    return kind > 4.5 ? kind_read5 : at;
 }
 
 // Read i of slot j at kernel offset d in the region whose origin is `node`.
@@ -260,12 +297,14 @@ vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
     vec2 k = kernel_offset(s.xy, s.zw, d);
     if (LAYERED != 0u && grouped) {
         // The layer kernels with the depth groups: one read, one coefficient for every channel
-        // (the plan's, in the read's slot) and no weight after it, so slot_gb is not loaded: a
-        // CPU implementation pays for each shared-memory load of every visit (two of seven
-        // took 12 % of colonnade's convolution on lavapipe). The same products as one_read's.
-        vec4 at = slot_read[READS * j];
-        vec2 q = clamp(k + slot_read[READS * j + 1u].xy, vec2(-at.z), vec2(at.z));
-        return at.w * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
+        // (the plan's) and no weight after it, so one word says the read (kind, coefficient,
+        // offset) and slot_gb is not loaded: a CPU implementation pays for each shared-memory
+        // load of every visit (two of seven took 12 % of colonnade's convolution on lavapipe).
+        // The same values and products as one_read's.
+        vec4 read = slot_read[READS * j + 2u];
+        vec3 at = layer_read_of(read.x);
+        vec2 q = clamp(k + read.zw, vec2(-at.z), vec2(at.z));
+        return read.y * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
     }
     vec4 gb0 = slot_gb[2u * j];
     vec4 gb1 = slot_gb[2u * j + 1u];
@@ -301,6 +340,9 @@ vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
 
 // The walk: batches of slots, each visited by the subgroups whose rows it reaches.
 void walk_slots(uint n, uint base, uint ty, vec3 extent) {
+    if (LAYERED != 0u) {
+        load_kind_reads();
+    }
     uint local_index = gl_LocalInvocationIndex;
     uint row = gl_LocalInvocationID.y;
     if (local_index < 8u) {
