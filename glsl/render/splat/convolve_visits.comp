@@ -177,13 +177,7 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
         bool used = i < plan.counts[s];
         uint l = used ? uint(plan.levels[3u * s + i]) : 0u;
         coef[i] = used ? plan.coefs[3u * s + i] : vec3(0.0);
-        if (LAYERED != 0u) {
-            // The layer texture's slot for this fragment's kind (plain or its block side), and
-            // in the second read's place the offset added to the slot's kernel offset.
-            uint kind = layer_kind(block_size(f));
-            slot_read[READS * j + i] = i == 1u ? vec4(0.0)
-                : vec4(layer_point(kind), used ? layer_bound(kind) : 0.0, coef[i].r);
-        } else {
+        if (LAYERED == 0u) {
             // A merged block of 4×4 and up reads its side's block-summed kernel (kernel_slot).
             uint at = kernel_slot(l, block_size(f));
             // An unused read stays harmless: its bound rejects every offset.
@@ -194,10 +188,10 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
     if (LAYERED != 0u) {
-        // The third read's place, unused when layered, holds what the grouped visit loads: the
-        // read's kind (its point and bound are in registers: layer_read_of), its coefficient
-        // and its offset.
-        slot_read[READS * j + 2u] = vec4(float(layer_kind(block_size(f))), coef[0].r, 0.0, 0.0);
+        // Layered, one word says the read (layered_read): the layer texture's kind for this
+        // fragment (plain or its block side), the coefficient, one for every channel, and the
+        // offset added to the kernel offset.
+        slot_read[READS * j] = vec4(float(layer_kind(block_size(f))), coef[0].r, 0.0, 0.0);
     }
 }
 
@@ -215,19 +209,14 @@ void fill_wide_block_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach,
     if (size == 2u) {
         shift = -kernel_offset(scale.xy, scale.zw, 0.5 * corner);
         share = 0.25;
-        slot_read[READS * j] = vec4(layer_point(0u), layer_bound(0u), 0.0);
     } else {
         vec2 h = block_box(size, scale.xy, scale.zw);
         shift = corner * h;
         share = corner.x * corner.y / (4.0 * h.x * h.y);
-        slot_read[READS * j] = vec4(sat_point(), float(layer_header.w) + 0.5, 0.0);
     }
-    slot_read[READS * j].w = share * plan.coefs[0].r;
-    slot_read[READS * j + 1u] = vec4(shift, 0.0, 0.0);
-    slot_read[READS * j + 2u] =
+    // Only the grouped blend reads blocks so (block_reads), so no per-channel word is needed.
+    slot_read[READS * j] =
         vec4(size == 2u ? 0.0 : float(SAT_KIND), share * plan.coefs[0].r, shift);
-    vec4 gb = slot_gb[2u * j];
-    slot_gb[2u * j] = vec4(share * gb.xy, gb.zw);
 }
 
 // Layered: each read kind's texture point and bound (kinds 0–4: layer_point, layer_bound;
@@ -259,22 +248,30 @@ vec3 layer_read_of(float kind) {
     return kind > 4.5 ? kind_read5 : at;
 }
 
-// Read i of slot j at kernel offset d in the region whose origin is `node`.
+// Layered (on axis only): slot j's one read at kernel offset k, times its coefficient. Its word
+// (fill_slot, fill_wide_block_slot) holds the read's kind, coefficient and offset; the kind's
+// point and bound come from registers, so a visit loads one word for it: a CPU implementation
+// pays for each shared-memory load of every visit (two of seven took 12 % of colonnade's
+// convolution on lavapipe). Clamped to the bound, where the slot's zero ring (or the table's
+// edge) lies. Every layered read comes from the single floats, which hold the tables too: one
+// texture, so a CPU implementation makes one read per visit.
+vec3 layered_read(uint j, vec2 k, float layer, vec2 extent) {
+    vec4 read = slot_read[READS * j];
+    vec3 at = layer_read_of(read.x);
+    vec2 q = clamp(k + read.zw, vec2(-at.z), vec2(at.z));
+    return read.y * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
+}
+
+// Radius levels: read i of slot j at kernel offset d in the region whose origin is `node`.
 vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 extent) {
     vec4 at = slot_read[READS * j + i];
     vec3 w = vec3(0.0);
-    if (LAYERED != 0u) {
-        // Clamped to the bound, where the slot's zero ring (or the table's edge) lies. Every
-        // layered read comes from the single floats, which hold the tables too: one texture,
-        // so a CPU implementation makes one read per visit.
-        vec2 q = clamp(d + slot_read[READS * j + 1u].xy, vec2(-at.z), vec2(at.z));
-        vec3 uvw = vec3((node + at.xy + q) / extent, layer);
-        return vec3(at.w, gb_r.xy) * textureLod(layer_sums, uvw, 0.0).rgb;
-    }
     // Past the block's zero ring lie other blocks: nothing counts there. An unused read's
     // bound is 0. (A GPU skips the read here; a CPU implementation reads and discards.)
     if (all(lessThan(abs(d), vec2(at.z)))) {
         vec3 uvw = vec3((node + at.xy + d) / extent, layer);
+        // (Layered reads go through layered_read; the layer texture named here keeps its
+        // binding in the shader, whose bindings run without gaps.)
         w = vec3(at.w, gb_r.xy) * (LAYERED != 0u ? textureLod(layer_texture, uvw, 0.0).rgb
                                                  : textureLod(psf_texture, uvw, 0.0).rgb);
     }
@@ -282,9 +279,6 @@ vec3 one_read(uint j, uint i, vec3 gb_r, vec2 d, vec2 node, float layer, vec2 ex
 }
 
 vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2 extent) {
-    if (LAYERED != 0u) {
-        return one_read(j, 0u, gb0.xyz, d, node, layer, extent);
-    }
     return one_read(j, 0u, gb0.xyz, d, node, layer, extent)
          + one_read(j, 1u, vec3(gb0.zw, 0.0), d, node, layer, extent)
          + one_read(j, 2u, gb1.xyz, d, node, layer, extent);
@@ -296,20 +290,15 @@ vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
     vec4 s = slot_scale[j];
     vec2 k = kernel_offset(s.xy, s.zw, d);
     if (LAYERED != 0u && grouped) {
-        // The layer kernels with the depth groups: one read, one coefficient for every channel
-        // (the plan's) and no weight after it, so one word says the read (kind, coefficient,
-        // offset) and slot_gb is not loaded: a CPU implementation pays for each shared-memory
-        // load of every visit (two of seven took 12 % of colonnade's convolution on lavapipe).
-        // The same values and products as one_read's.
-        vec4 read = slot_read[READS * j + 2u];
-        vec3 at = layer_read_of(read.x);
-        vec2 q = clamp(k + read.zw, vec2(-at.z), vec2(at.z));
-        return read.y * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
+        // With the depth groups no weight follows the read: slot_gb is not loaded.
+        return layered_read(j, k, layer, extent);
     }
     vec4 gb0 = slot_gb[2u * j];
     vec4 gb1 = slot_gb[2u * j + 1u];
     vec3 w;
-    if (OFF_AXIS == 0u) {
+    if (LAYERED != 0u) {
+        w = layered_read(j, k, layer, extent);
+    } else if (OFF_AXIS == 0u) {
         w = slot_reads(j, gb0, gb1, k, vec2(0.0), layer, extent);
     } else {
         vec4 weights = slot_node_weights[j];
