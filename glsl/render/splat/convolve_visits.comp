@@ -195,28 +195,21 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     }
 }
 
-// Layered, a merged block in the wide field (block_reads in splat.glsl) takes four slots
-// of one read each, s = 0 … 3: a 2×2 block its four pixels' kernels where they lie in kernel
-// space, a larger block the four corners of its box in the summed-area table with signs
-// + − − +. Each slot carries its share of the coefficient and the offset of its read.
-void fill_wide_block_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale,
-                          float post, float pixels) {
+// Layered, a merged block in the wide field (block_reads in splat.glsl) makes four reads in one
+// visit (layered_read): a 2×2 block its four pixels' kernels where they lie in kernel space,
+// J·(±½, ±½) from its centre (WIDE_PAIR_KIND: the plain kernel, four times), a larger block
+// the four corners of its box in the summed-area table with signs + − − + (SAT_KIND; the
+// word's offset holds the box's half-sides). The coefficient carries the block's share.
+const uint WIDE_PAIR_KIND = 6u;
+void fill_wide_block_slot(uint j, Fragment f, ReadPlan plan, vec4 reach, vec4 scale, float post,
+                          float pixels) {
     fill_slot(j, f, plan, 0u, reach, scale, post, pixels);
-    vec2 corner = vec2((s & 1u) == 0u ? 1.0 : -1.0, s < 2u ? 1.0 : -1.0);
     uint size = block_size(f);
-    float share;
-    vec2 shift;
-    if (size == 2u) {
-        shift = -kernel_offset(scale.xy, scale.zw, 0.5 * corner);
-        share = 0.25;
-    } else {
-        vec2 h = block_box(size, scale.xy, scale.zw);
-        shift = corner * h;
-        share = corner.x * corner.y / (4.0 * h.x * h.y);
-    }
+    vec2 h = block_box(size, scale.xy, scale.zw);
     // Only the grouped blend reads blocks so (block_reads), so no per-channel word is needed.
-    slot_read[READS * j] =
-        vec4(size == 2u ? 0.0 : float(SAT_KIND), share * plan.coefs[0].r, shift);
+    slot_read[READS * j] = size == 2u
+        ? vec4(float(WIDE_PAIR_KIND), 0.25 * plan.coefs[0].r, 0.0, 0.0)
+        : vec4(float(SAT_KIND), plan.coefs[0].r / (4.0 * h.x * h.y), h);
 }
 
 // Layered: each read kind's texture point and bound (kinds 0–4: layer_point, layer_bound;
@@ -245,21 +238,41 @@ vec3 layer_read_of(float kind) {
     at = kind > 1.5 ? kind_read2 : at;
     at = kind > 2.5 ? kind_read3 : at;
     at = kind > 3.5 ? kind_read4 : at;
-    return kind > 4.5 ? kind_read5 : at;
+    at = kind > 4.5 ? kind_read5 : at;
+    return kind > 5.5 ? kind_read0 : at;
 }
 
-// Layered (on axis only): slot j's one read at kernel offset k, times its coefficient. Its word
-// (fill_slot, fill_wide_block_slot) holds the read's kind, coefficient and offset; the kind's
-// point and bound come from registers, so a visit loads one word for it: a CPU implementation
-// pays for each shared-memory load of every visit (two of seven took 12 % of colonnade's
-// convolution on lavapipe). Clamped to the bound, where the slot's zero ring (or the table's
-// edge) lies. Every layered read comes from the single floats, which hold the tables too: one
-// texture, so a CPU implementation makes one read per visit.
-vec3 layered_read(uint j, vec2 k, float layer, vec2 extent) {
+// Layered (on axis only): slot j's reads at kernel offset k, times its coefficient; s is the
+// slot's local scale. Its word (fill_slot, fill_wide_block_slot) holds the read's kind,
+// coefficient and offset; the kind's point and bound come from registers, so a visit loads one
+// word for it: a CPU implementation pays for each shared-memory load of every visit (two of
+// seven took 12 % of colonnade's convolution on lavapipe). A wide-field block's four reads are
+// a loop of four in the same visit, not four visits: the loop's trip count, uniform in the
+// subgroup, is the one thing such an implementation skips, and a visit's loads, reach test
+// and blend cost about three times its read. Each read is clamped to the bound, where the
+// slot's zero ring (or the table's edge) lies. Every layered read comes from the single
+// floats, which hold the tables too: one texture, so a CPU implementation makes one read per
+// step.
+vec3 layered_read(uint j, vec2 k, vec4 s, float layer, vec2 extent) {
     vec4 read = slot_read[READS * j];
     vec3 at = layer_read_of(read.x);
-    vec2 q = clamp(k + read.zw, vec2(-at.z), vec2(at.z));
-    return read.y * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
+    bool wide = read.x > 4.5;
+    bool box = wide && read.x < 5.5;
+    // Steps to the four reads, k ± a ± b: a 2×2 block's pixels lie at J·(±½, ±½), a box's
+    // corners at (±h.x, ±h.y).
+    vec2 a = box ? vec2(read.z, 0.0) : kernel_offset(s.xy, s.zw, vec2(0.5, 0.0));
+    vec2 b = box ? vec2(0.0, read.w) : kernel_offset(s.xy, s.zw, vec2(0.0, 0.5));
+    a = wide ? a : vec2(0.0);
+    b = wide ? b : vec2(0.0);
+    uint n = wide ? 4u : 1u;
+    vec3 w = vec3(0.0);
+    for (uint i = 0u; i < n; i++) {
+        vec2 corner = vec2((i & 1u) == 0u ? 1.0 : -1.0, i < 2u ? 1.0 : -1.0);
+        vec2 q = clamp(k + corner.x * a + corner.y * b, vec2(-at.z), vec2(at.z));
+        float sign = box ? corner.x * corner.y : 1.0;
+        w += sign * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
+    }
+    return read.y * w;
 }
 
 // Radius levels: read i of slot j at kernel offset d in the region whose origin is `node`.
@@ -291,13 +304,13 @@ vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
     vec2 k = kernel_offset(s.xy, s.zw, d);
     if (LAYERED != 0u && grouped) {
         // With the depth groups no weight follows the read: slot_gb is not loaded.
-        return layered_read(j, k, layer, extent);
+        return layered_read(j, k, s, layer, extent);
     }
     vec4 gb0 = slot_gb[2u * j];
     vec4 gb1 = slot_gb[2u * j + 1u];
     vec3 w;
     if (LAYERED != 0u) {
-        w = layered_read(j, k, layer, extent);
+        w = layered_read(j, k, s, layer, extent);
     } else if (OFF_AXIS == 0u) {
         w = slot_reads(j, gb0, gb1, k, vec2(0.0), layer, extent);
     } else {
@@ -349,6 +362,7 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
         float post = 1.0;
         float pixels = 1.0;
         uint slots = 0u;
+        bool wide_block = false;
         if (loaded) {
             f = load_fragment(entries[base + start + local_index].y);
             vec3 s = local_scale(f.center);
@@ -369,9 +383,7 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
             pixels = !grouped && size > 1u ? n_px : 1.0;
             plan = plan_reads(f, pre);
             slots = plan.slots;
-            if (LAYERED != 0u && size > 1u && scaled && block_reads()) {
-                slots = 4u;
-            }
+            wide_block = LAYERED != 0u && size > 1u && scaled && block_reads();
         }
         entry_slots[local_index] = slots;
         if (local_index == 0u) {
@@ -392,10 +404,8 @@ void walk_slots(uint n, uint base, uint ty, vec3 extent) {
         // very test the pixels make below.
         if (fits) {
             atomicAdd(batch_taken, 1u);
-            if (slots == 4u) {
-                [[unroll]] for (uint k = 0u; k < 4u; k++) {
-                    fill_wide_block_slot(first + k, f, plan, k, reach, scale, post, pixels);
-                }
+            if (wide_block) {
+                fill_wide_block_slot(first, f, plan, reach, scale, post, pixels);
             } else {
                 [[unroll]] for (uint k = 0u; k < 3u; k++) {
                     if (k < slots) {
