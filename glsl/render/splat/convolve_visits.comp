@@ -80,7 +80,8 @@ const uint SLOTS = 96u;
 // span three radius levels).
 const uint READS = 3u;
 shared vec4 slot_reach[SLOTS];     // centre.xy, reach, the texture layer coordinate
-shared vec4 slot_scale[SLOTS];     // radial unit vector, radial and tangential shrink ((1, 1): none)
+shared vec4 slot_scale[SLOTS];     // the local scale's map J (J₁₁, J₁₂, J₂₂; I: none), layered the
+                                   // read's code (layered_read), else 0
 shared vec4 slot_color[SLOTS];     // linear RGB, vergence (D)
 shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's offset 0 (slot_point), bound, red coefficient
 shared vec4 slot_gb[SLOTS * 2u];   // green and blue coefficients of the three reads, then the
@@ -165,11 +166,15 @@ ReadPlan plan_reads(Fragment f, float pre) {
     return plan;
 }
 
-// Fills slot j with slot s of fragment f's plan.
+// Fills slot j with slot s of fragment f's plan; scale holds the radial unit vector and the
+// (radial, tangential) shrink, code the layered read's (layered_read).
 void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale, float post,
-               float pixels) {
+               float pixels, float code) {
     slot_reach[j] = reach;
-    slot_scale[j] = scale;
+    // J = c_t·I + (c_r − c_t)·e·eᵀ (kernel_offset in splat.glsl), symmetric: three numbers.
+    vec2 e = scale.xy;
+    float c = scale.z - scale.w;
+    slot_scale[j] = vec4(scale.w + c * e.x * e.x, c * e.x * e.y, scale.w + c * e.y * e.y, code);
     slot_color[j] = vec4(f.color, f.dioptre);
     slot_hidden[j] = uvec4(f.size, floatBitsToUint(f.radius));
     vec3 coef[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
@@ -187,29 +192,23 @@ void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale
     }
     slot_gb[2u * j] = vec4(coef[0].gb, coef[1].gb);
     slot_gb[2u * j + 1u] = vec4(coef[2].gb, post, pixels);
-    if (LAYERED != 0u) {
-        // Layered, one word says the read (layered_read): the layer texture's kind for this
-        // fragment (plain or its block side), the coefficient, one for every channel, and the
-        // offset added to the kernel offset.
-        slot_read[READS * j] = vec4(float(layer_kind(block_size(f))), coef[0].r, 0.0, 0.0);
+    if (LAYERED != 0u && !grouped) {
+        // Layered with the per-fragment blend, the read's coefficient (grouped, layered_read
+        // computes it), one for every channel.
+        slot_read[READS * j] = vec4(0.0, coef[0].r, 0.0, 0.0);
     }
 }
 
-// Layered, a merged block in the wide field (block_reads in splat.glsl) makes four reads in one
-// visit (layered_read): a 2×2 block its four pixels' kernels where they lie in kernel space,
-// J·(±½, ±½) from its centre (WIDE_PAIR_KIND: the plain kernel, four times), a larger block
-// the four corners of its box in the summed-area table with signs + − − + (SAT_KIND; the
-// word's offset holds the box's half-sides). The coefficient carries the block's share.
+// Layered, a slot's read is one of seven kinds: the layer texture's kind for the fragment
+// (0: plain, 1–4: the block side's summed kernel), SAT_KIND for a merged block of 4×4 and up in
+// the wide field (block_reads in splat.glsl: the four corners of its box in the summed-area
+// table, with signs + − − +) and WIDE_PAIR_KIND for a 2×2 block there (its four pixels' plain
+// kernels where they lie in kernel space, J·(±½, ±½) from its centre). The code says the kind
+// and the block side: kind + 8·side, exact in a float.
 const uint WIDE_PAIR_KIND = 6u;
-void fill_wide_block_slot(uint j, Fragment f, ReadPlan plan, vec4 reach, vec4 scale, float post,
-                          float pixels) {
-    fill_slot(j, f, plan, 0u, reach, scale, post, pixels);
-    uint size = block_size(f);
-    vec2 h = block_box(size, scale.xy, scale.zw);
-    // Only the grouped blend reads blocks so (block_reads), so no per-channel word is needed.
-    slot_read[READS * j] = size == 2u
-        ? vec4(float(WIDE_PAIR_KIND), 0.25 * plan.coefs[0].r, 0.0, 0.0)
-        : vec4(float(SAT_KIND), plan.coefs[0].r / (4.0 * h.x * h.y), h);
+float read_code(uint size, bool wide_block) {
+    uint kind = !wide_block ? layer_kind(size) : size == 2u ? WIDE_PAIR_KIND : SAT_KIND;
+    return float(kind + 8u * size);
 }
 
 // Layered: each read kind's texture point and bound (kinds 0–4: layer_point, layer_bound;
@@ -222,8 +221,10 @@ vec3 kind_read2;
 vec3 kind_read3;
 vec3 kind_read4;
 vec3 kind_read5;
+float inv_layer_scale;
 
 void load_kind_reads() {
+    inv_layer_scale = 1.0 / layer_scale();
     kind_read0 = vec3(layer_point(0u), layer_bound(0u));
     kind_read1 = vec3(layer_point(1u), layer_bound(1u));
     kind_read2 = vec3(layer_point(2u), layer_bound(2u));
@@ -242,28 +243,38 @@ vec3 layer_read_of(float kind) {
     return kind > 5.5 ? kind_read0 : at;
 }
 
-// Layered (on axis only): slot j's reads at kernel offset k, times its coefficient; s is the
-// slot's local scale. Its word (fill_slot, fill_wide_block_slot) holds the read's kind,
-// coefficient and offset; the kind's point and bound come from registers, so a visit loads one
-// word for it: a CPU implementation pays for each shared-memory load of every visit (two of
-// seven took 12 % of colonnade's convolution on lavapipe). A wide-field block's four reads are
-// a loop of four in the same visit, not four visits: the loop's trip count, uniform in the
-// subgroup, is the one thing such an implementation skips, and a visit's loads, reach test
-// and blend cost about three times its read. Each read is clamped to the bound, where the
-// slot's zero ring (or the table's edge) lies. Every layered read comes from the single
-// floats, which hold the tables too: one texture, so a CPU implementation makes one read per
-// step.
+// Layered (on axis only): slot j's reads at kernel offset k, times their coefficient; s is the
+// slot's J and read code. A visit loads no word for the read: the kind and block side come
+// from the code, the kind's point and bound from registers (load_kind_reads), and with the
+// depth groups the coefficient from J, since a CPU implementation pays for each shared-memory
+// load of every visit (two of seven took 12 % of colonnade's convolution on lavapipe): the
+// kernel's weight det J (the local scale's area), times the block's s² pixels, where a wide
+// 2×2 block's four reads share them and a box's mean is over its area s²·J₁₁·J₂₂. A wide
+// block's four reads are a loop of four in the same visit, not four visits: the loop's trip
+// count, uniform in the subgroup, is the one thing such an implementation skips, and a visit's
+// loads, reach test and blend cost about three times its read. Each read is clamped to the
+// bound, where the slot's zero ring (or the table's edge) lies. Every layered read comes from
+// the single floats, which hold the tables too: one texture, so a CPU implementation makes one
+// read per step.
 vec3 layered_read(uint j, vec2 k, vec4 s, float layer, vec2 extent) {
-    vec4 read = slot_read[READS * j];
-    vec3 at = layer_read_of(read.x);
-    bool wide = read.x > 4.5;
-    bool box = wide && read.x < 5.5;
+    float size = floor(s.w * 0.125);
+    float kind = s.w - 8.0 * size;
+    vec3 at = layer_read_of(kind);
+    bool wide = kind > 4.5;
+    bool box = wide && kind < 5.5;
     // Steps to the four reads, k ± a ± b: a 2×2 block's pixels lie at J·(±½, ±½), a box's
-    // corners at (±h.x, ±h.y).
-    vec2 a = box ? vec2(read.z, 0.0) : kernel_offset(s.xy, s.zw, vec2(0.5, 0.0));
-    vec2 b = box ? vec2(0.0, read.w) : kernel_offset(s.xy, s.zw, vec2(0.0, 0.5));
+    // corners at ±(s/2)·(J₁₁, J₂₂) (block_box).
+    vec2 a = box ? vec2(0.5 * size * s.x, 0.0) : 0.5 * s.xy;
+    vec2 b = box ? vec2(0.0, 0.5 * size * s.z) : 0.5 * s.yz;
     a = wide ? a : vec2(0.0);
     b = wide ? b : vec2(0.0);
+    float coef;
+    if (grouped) {
+        float area = s.x * s.z - s.y * s.y;
+        coef = area * inv_layer_scale * (box ? 1.0 / (s.x * s.z) : wide ? 1.0 : size * size);
+    } else {
+        coef = slot_read[READS * j].y;
+    }
     uint n = wide ? 4u : 1u;
     vec3 w = vec3(0.0);
     for (uint i = 0u; i < n; i++) {
@@ -272,7 +283,7 @@ vec3 layered_read(uint j, vec2 k, vec4 s, float layer, vec2 extent) {
         float sign = box ? corner.x * corner.y : 1.0;
         w += sign * textureLod(layer_sums, vec3((at.xy + q) / extent, layer), 0.0).rgb;
     }
-    return read.y * w;
+    return coef * w;
 }
 
 // Radius levels: read i of slot j at kernel offset d in the region whose origin is `node`.
@@ -301,7 +312,7 @@ vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2
 // reads, off axis the four field nodes mixed bilinearly.
 vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
     vec4 s = slot_scale[j];
-    vec2 k = kernel_offset(s.xy, s.zw, d);
+    vec2 k = vec2(s.x * d.x + s.y * d.y, s.y * d.x + s.z * d.y);
     if (LAYERED != 0u && grouped) {
         // With the depth groups no weight follows the read: slot_gb is not loaded.
         return layered_read(j, k, s, layer, extent);
@@ -414,13 +425,10 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
         // pixels' own test below is exact).
         if (fits) {
             atomicAdd(batch_taken, 1u);
-            if (wide_block) {
-                fill_wide_block_slot(first, f, plan, reach, scale, post, pixels);
-            } else {
-                [[unroll]] for (uint k = 0u; k < 3u; k++) {
-                    if (k < slots) {
-                        fill_slot(first + k, f, plan, k, reach, scale, post, pixels);
-                    }
+            float code = LAYERED != 0u ? read_code(block_size(f), wide_block) : 0.0;
+            [[unroll]] for (uint k = 0u; k < 3u; k++) {
+                if (k < slots) {
+                    fill_slot(first + k, f, plan, k, reach, scale, post, pixels, code);
                 }
             }
             if (OFF_AXIS != 0u) {
