@@ -138,7 +138,7 @@ pub enum ConvolveWalk {
     Auto,
     /// Every pixel of a tile over every fragment, branching past what a fragment does not need.
     Pixels,
-    /// Planned reads in shared memory, each visited by the subgroups whose rows it reaches.
+    /// Planned reads in shared memory, each visited by the subgroups whose pixels it reaches.
     Visits,
 }
 
