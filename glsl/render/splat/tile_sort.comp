@@ -20,11 +20,96 @@ const uint SHARED_CAPACITY = 2048u;
 // barrier instead of the network's log² n, and keys are unique (the fragment index breaks
 // ties), so ranks are a permutation. Each thread ranks RANK_KEYS consecutive keys in one pass
 // over the list: on a CPU implementation (lavapipe runs a subgroup's loop only while one of its
-// threads has keys, and one load serves every comparison of a step) 8 keys a thread and lists
-// up to 1024 sort faster than the network; on a GPU 2 keys and 512 (the network beyond).
+// threads has keys, and one load serves every comparison of a step) 8 keys a thread, and
+// there the keys are bucketed first (bucketed_rank_sort), so lists up to 2048 sort that way;
+// on a GPU 2 keys and 512 (the network beyond).
 layout(constant_id = 0) const uint RANK_KEYS = 2u;
 const uint RANK_SORT_LIMIT = RANK_KEYS >= 4u ? 1024u : 256u * RANK_KEYS;
 shared uvec2 keys[SHARED_CAPACITY];
+// With four or more keys a thread (a CPU implementation) the rank sort first buckets the keys by
+// depth, so that a key is compared only with the keys of nearby buckets: a bucket is a
+// monotone function of the depth, so every key of an earlier bucket is smaller and every key
+// of a later one larger. The order is the same; the comparisons fall from n² to about n times
+// a bucket's size (a 640×360 colonnade's lists hold hundreds to a few thousand entries).
+const uint BUCKETS = 128u;
+shared uint bucket_count[BUCKETS];
+shared uint bucket_start[BUCKETS];
+shared uint depth_lo;
+shared uint depth_hi;
+
+uint bucket_of(uint depth, float scale) {
+    return min(BUCKETS - 1u, uint(float(depth - depth_lo) * scale));
+}
+
+// The rank sort by buckets (RANK_KEYS ≥ 4, n ≤ SHARED_CAPACITY): the list is read twice from
+// the entries, and keys[0, n) takes it bucket by bucket.
+void bucketed_rank_sort(uint n, uint base, uint t) {
+    if (t == 0u) {
+        depth_lo = 0xFFFFFFFFu;
+        depth_hi = 0u;
+    }
+    if (t < BUCKETS) {
+        bucket_count[t] = 0u;
+    }
+    barrier();
+    for (uint i = t; i < n; i += 256u) {
+        uint depth = entries[base + i].x;
+        atomicMin(depth_lo, depth);
+        atomicMax(depth_hi, depth);
+    }
+    barrier();
+    float scale = float(BUCKETS) / (float(depth_hi - depth_lo) + 1.0);
+    for (uint i = t; i < n; i += 256u) {
+        atomicAdd(bucket_count[bucket_of(entries[base + i].x, scale)], 1u);
+    }
+    barrier();
+    if (t == 0u) {
+        uint sum = 0u;
+        for (uint b = 0u; b < BUCKETS; b++) {
+            bucket_start[b] = sum;
+            sum += bucket_count[b];
+        }
+    }
+    barrier();
+    if (t < BUCKETS) {
+        // From here a cursor: the bucket's next free place.
+        bucket_count[t] = bucket_start[t];
+    }
+    barrier();
+    for (uint i = t; i < n; i += 256u) {
+        uvec2 key = entries[base + i];
+        keys[atomicAdd(bucket_count[bucket_of(key.x, scale)], 1u)] = key;
+    }
+    barrier();
+    // This thread's keys are consecutive in bucket order; every key before the first one's
+    // bucket is smaller than all of them, every key after the last one's bucket larger.
+    uint first = RANK_KEYS * t;
+    if (first >= n) {
+        return;
+    }
+    uint last = min(first + RANK_KEYS, n) - 1u;
+    uint from = bucket_start[bucket_of(keys[first].x, scale)];
+    // The cursor of the last key's bucket stands at that bucket's end.
+    uint to = bucket_count[bucket_of(keys[last].x, scale)];
+    uvec2 mine[RANK_KEYS];
+    uint rank[RANK_KEYS];
+    [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+        uint i = first + k;
+        mine[k] = i < n ? keys[i] : uvec2(0u);
+        rank[k] = from;
+    }
+    for (uint j = from; j < to; j++) {
+        uvec2 other = keys[j];
+        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+            rank[k] += key_less(other, mine[k]) ? 1u : 0u;
+        }
+    }
+    [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+        if (first + k < n) {
+            entries[base + rank[k]] = mine[k];
+        }
+    }
+}
 
 void main() {
     load_band();
@@ -40,6 +125,10 @@ void main() {
     uint t = gl_LocalInvocationID.x;
     uint m = 1u;
     while (m < n) m <<= 1u;
+    if (RANK_KEYS >= 4u && n <= min(SHARED_CAPACITY, 256u * RANK_KEYS)) {
+        bucketed_rank_sort(n, base, t);
+        return;
+    }
     if (n <= RANK_SORT_LIMIT) {
         for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
         barrier();
