@@ -112,6 +112,12 @@ vec2 kernel_offset(vec2 e, vec2 c, vec2 d) {
     return c.y * d + (c.x - c.y) * dot(d, e) * e;
 }
 
+// The same map as a matrix, J = c_t·I + (c_r − c_t)·e·eᵀ: symmetric, so (J₁₁, J₁₂, J₂₂).
+vec3 local_map(vec2 e, vec2 c) {
+    float r = c.x - c.y;
+    return vec3(c.y + r * e.x * e.x, r * e.x * e.y, c.y + r * e.y * e.y);
+}
+
 // Whether a merged block in the wide field reads its pixels where they lie in kernel space
 // (glsl/common/layer_atlas.glsl: the layer kernels with the depth-group blend), rather than
 // one read that assumes them one texel apart (merge.comp bounds that read's misplacement).

@@ -171,10 +171,7 @@ ReadPlan plan_reads(Fragment f, float pre) {
 void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale, float post,
                float pixels, float code) {
     slot_reach[j] = reach;
-    // J = c_t·I + (c_r − c_t)·e·eᵀ (kernel_offset in splat.glsl), symmetric: three numbers.
-    vec2 e = scale.xy;
-    float c = scale.z - scale.w;
-    slot_scale[j] = vec4(scale.w + c * e.x * e.x, c * e.x * e.y, scale.w + c * e.y * e.y, code);
+    slot_scale[j] = vec4(local_map(scale.xy, scale.zw), code);
     slot_color[j] = vec4(f.color, f.dioptre);
     slot_hidden[j] = uvec4(f.size, floatBitsToUint(f.radius));
     vec3 coef[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));

@@ -21,11 +21,40 @@ const uint SHARED_CAPACITY = 2048u;
 // ties), so ranks are a permutation. Each thread ranks RANK_KEYS consecutive keys in one pass
 // over the list: on a CPU implementation (lavapipe runs a subgroup's loop only while one of its
 // threads has keys, and one load serves every comparison of a step) 8 keys a thread, and
-// there the keys are bucketed first (bucketed_rank_sort), so lists up to 2048 sort that way;
-// on a GPU 2 keys and 512 (the network beyond).
+// there the keys are bucketed first (BUCKETED), so lists up to 2048 sort that way; on a GPU
+// 2 keys and 512 (the network beyond).
 layout(constant_id = 0) const uint RANK_KEYS = 2u;
-const uint RANK_SORT_LIMIT = RANK_KEYS >= 4u ? 1024u : 256u * RANK_KEYS;
+const uint RANK_SORT_LIMIT =
+    256u * RANK_KEYS > SHARED_CAPACITY ? SHARED_CAPACITY : 256u * RANK_KEYS;
+const bool BUCKETED = RANK_KEYS >= 4u;
 shared uvec2 keys[SHARED_CAPACITY];
+
+// Ranks this thread's RANK_KEYS consecutive keys, keys[first …], among keys[from, to) and
+// writes each to its place in the list: every key before `from` is smaller than all of them,
+// every key from `to` on larger.
+void rank_keys(uint first, uint n, uint from, uint to, uint base) {
+    if (first >= n) {
+        return;
+    }
+    uvec2 mine[RANK_KEYS];
+    uint rank[RANK_KEYS];
+    [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+        uint i = first + k;
+        mine[k] = i < n ? keys[i] : uvec2(0u);
+        rank[k] = from;
+    }
+    for (uint j = from; j < to; j++) {
+        uvec2 other = keys[j];
+        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+            rank[k] += key_less(other, mine[k]) ? 1u : 0u;
+        }
+    }
+    [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
+        if (first + k < n) {
+            entries[base + rank[k]] = mine[k];
+        }
+    }
+}
 // With four or more keys a thread (a CPU implementation) the rank sort first buckets the keys by
 // depth, so that a key is compared only with the keys of nearby buckets: a bucket is a
 // monotone function of the depth, so every key of an earlier bucket is smaller and every key
@@ -41,8 +70,8 @@ uint bucket_of(uint depth, float scale) {
     return min(BUCKETS - 1u, uint(float(depth - depth_lo) * scale));
 }
 
-// The rank sort by buckets (RANK_KEYS ≥ 4, n ≤ SHARED_CAPACITY): the list is read twice from
-// the entries, and keys[0, n) takes it bucket by bucket.
+// The rank sort by buckets (BUCKETED, n ≤ RANK_SORT_LIMIT): the list is read twice from the
+// entries, and keys[0, n) takes it bucket by bucket.
 void bucketed_rank_sort(uint n, uint base, uint t) {
     if (t == 0u) {
         depth_lo = 0xFFFFFFFFu;
@@ -91,24 +120,7 @@ void bucketed_rank_sort(uint n, uint base, uint t) {
     uint from = bucket_start[bucket_of(keys[first].x, scale)];
     // The cursor of the last key's bucket stands at that bucket's end.
     uint to = bucket_count[bucket_of(keys[last].x, scale)];
-    uvec2 mine[RANK_KEYS];
-    uint rank[RANK_KEYS];
-    [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
-        uint i = first + k;
-        mine[k] = i < n ? keys[i] : uvec2(0u);
-        rank[k] = from;
-    }
-    for (uint j = from; j < to; j++) {
-        uvec2 other = keys[j];
-        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
-            rank[k] += key_less(other, mine[k]) ? 1u : 0u;
-        }
-    }
-    [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
-        if (first + k < n) {
-            entries[base + rank[k]] = mine[k];
-        }
-    }
+    rank_keys(first, n, from, to, base);
 }
 
 void main() {
@@ -125,31 +137,13 @@ void main() {
     uint t = gl_LocalInvocationID.x;
     uint m = 1u;
     while (m < n) m <<= 1u;
-    if (RANK_KEYS >= 4u && n <= min(SHARED_CAPACITY, 256u * RANK_KEYS)) {
-        bucketed_rank_sort(n, base, t);
-        return;
-    }
     if (n <= RANK_SORT_LIMIT) {
-        for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
-        barrier();
-        uvec2 mine[RANK_KEYS];
-        uint rank[RANK_KEYS];
-        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
-            uint i = RANK_KEYS * t + k;
-            mine[k] = i < n ? keys[i] : uvec2(0u);
-            rank[k] = 0u;
-        }
-        uint steps = RANK_KEYS * t < n ? n : 0u;
-        for (uint j = 0u; j < steps; j++) {
-            uvec2 other = keys[j];
-            [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
-                rank[k] += key_less(other, mine[k]) ? 1u : 0u;
-            }
-        }
-        [[unroll]] for (uint k = 0u; k < RANK_KEYS; k++) {
-            if (RANK_KEYS * t + k < n) {
-                entries[base + rank[k]] = mine[k];
-            }
+        if (BUCKETED) {
+            bucketed_rank_sort(n, base, t);
+        } else {
+            for (uint i = t; i < n; i += 256u) keys[i] = entries[base + i];
+            barrier();
+            rank_keys(RANK_KEYS * t, n, 0u, n, base);
         }
         return;
     }
