@@ -102,11 +102,6 @@ vec3 layer_box(vec2 u, vec2 h, float layer) {
     return s / (4.0 * h.x * h.y * layer_scale());
 }
 
-// Half-sides in kernel space of the box of a block of side `size` whose local scale has
-// radial unit vector e and (radial, tangential) shrink c: s/2 times J's diagonal.
-vec2 block_box(uint size, vec2 e, vec2 c) {
-    return 0.5 * float(size) * (vec2(c.y) + (c.x - c.y) * e * e);
-}
 #endif
 
 #endif

@@ -107,12 +107,8 @@ vec2 shrink_for_radius(float cos_theta, float r) {
     return vec2(1.0) + t * (vec2(cos_theta * cos_theta, cos_theta) - vec2(1.0));
 }
 
-// Kernel offset of screen offset d; e = radial unit vector, c = (radial, tangential) shrink.
-vec2 kernel_offset(vec2 e, vec2 c, vec2 d) {
-    return c.y * d + (c.x - c.y) * dot(d, e) * e;
-}
-
-// The same map as a matrix, J = c_t·I + (c_r − c_t)·e·eᵀ: symmetric, so (J₁₁, J₁₂, J₂₂).
+// The map of a screen offset d to its kernel offset J·d, J = c_t·I + (c_r − c_t)·e·eᵀ (e: the
+// radial unit vector, c: the (radial, tangential) shrink): symmetric, so (J₁₁, J₁₂, J₂₂).
 vec3 local_map(vec2 e, vec2 c) {
     float r = c.x - c.y;
     return vec3(c.y + r * e.x * e.x, r * e.x * e.y, c.y + r * e.y * e.y);
@@ -197,35 +193,95 @@ vec3 pupil_share(uint size, vec3 radius, float inner, vec2 d) {
     return mix(vec3(1.0), seen, clamp(r - 0.5, vec3(0.0), vec3(1.0)));
 }
 
-// How far, in whole pixels from the footprint centre, a fragment's kernel can be non-zero.
-// Kernels of radius r occupy (2r+1)² texels centred on the fragment; a merged fragment sits
-// half a pixel off the pixel grid, so bilinear filtering reaches half a pixel further, and a
-// block of side s ≥ 4 reads its block-summed kernel of (2r+s)² texels. Off the centre of a
-// wide frame a kernel stretches by up to 1/cos²θ and is read bilinearly between texels, so it
-// reaches up to (r + 1)/cos²θ, exclusive.
-float fragment_reach(Fragment f) {
-    float radius = max(f.radius.r, max(f.radius.g, f.radius.b));
-    // Layered, the two object distances' kernels around the fragment's are each as wide as
-    // their own radius, which lies within radius_step of the fragment's.
-    float r = ceil(radius + frame.radius_step);
+// Where a fragment's kernel can be non-zero, in kernel space: its reads at kernel offset
+// k = J·d of a screen offset d (J: the local scale's map, (J₁₁, J₁₂, J₂₂), I where none
+// applies) are zero unless |k.x| and |k.y| are below its bound. Tested in kernel space, a
+// kernel off the centre of a wide frame covers the parallelogram J⁻¹·square on the screen;
+// the square around that, what the reach test was, holds up to twice as many pixels (a third
+// more over a 60° frame), all of them read as zeros and all of them splitting the pixel's depth
+// groups. One bound for both axes, so that a visit tests it without computing it.
+struct Footprint {
+    vec3 map;     // J
+    float bound;  // exclusive half-side of the square in kernel space
+};
+
+// The bound of a kernel of block radius r (footprint_radius) at local map j, for a fragment of
+// block side `size`; wide_block: a merged block that reads its pixels where they lie
+// (block_reads, off the centre).
+float footprint_bound(float r, vec3 j, uint size, bool wide_block) {
+    // The block-summed kernel, (2r + s)² texels; in the wide field the box of half-sides
+    // (s/2)·(J₁₁, J₂₂) over the plain kernel, whose texels cover r + ½ each way.
+    float box = r + 0.5 + 0.5 * float(size) * (wide_block ? max(j.x, j.z) : 1.0);
+    // Bilinear reads reach one texel past the block; a wide 2×2 block reads its four pixels'
+    // kernels at J·(±½, ±½) from its centre.
+    float pair = r + 1.0 + (wide_block ? 0.5 * (abs(j.y) + max(abs(j.x), abs(j.z))) : 0.0);
+    return size >= 4u ? box : size == 2u ? pair : r + 1.0;
+}
+
+// Layered, the two object distances' kernels around the fragment's are each as wide as their
+// own radius, which lies within radius_step of the fragment's; a kernel of radius r fills the
+// (2⌈r⌉+1)² texels of its block.
+float footprint_radius(Fragment f) {
+    return ceil(max(f.radius.r, max(f.radius.g, f.radius.b)) + frame.radius_step);
+}
+
+// The local scale's map of a fragment (xyz), I where none applies, and 1 where it applies
+// (w): the largest channel radius decides how much of it applies (shrink_for_radius).
+vec4 fragment_map(Fragment f) {
     vec3 s = local_scale(f.center);
-    vec2 c = shrink_for_radius(s.z, radius);
-    uint size = block_size(f);
-    // Bilinear reads reach one texel past the block: the kernel is non-zero for kernel offsets
-    // inside the square of half-side r + 1. Screen offsets are its image under the inverse map
-    // (1/c_t)·I + (1/c_r − 1/c_t)·e·eᵀ, whose extent along a grid axis is the largest row sum
-    // of its absolute values.
-    float a = 1.0 / c.x - 1.0 / c.y;
-    float along = max(s.x * s.x, s.y * s.y) + abs(s.x * s.y);
-    float stretch = c.x < 1.0 ? 1.0 / c.y + a * along : 1.0;
-    if (size >= 4u) {
-        // Non-zero strictly within r + s/2 + ½ of the centre; pixel offsets are half-integers.
-        return ceil((r + 0.5 * float(size) + 0.5) * stretch - 0.5) - 0.5;
+    vec2 c = shrink_for_radius(s.z, max(f.radius.r, max(f.radius.g, f.radius.b)));
+    return c.x < 1.0 ? vec4(local_map(s.xy, c), 1.0) : vec4(1.0, 0.0, 1.0, 0.0);
+}
+
+Footprint fragment_footprint(Fragment f) {
+    vec4 j = fragment_map(f);
+    return Footprint(j.xyz, footprint_bound(footprint_radius(f), j.xyz, block_size(f),
+                                            j.w > 0.5 && block_reads()));
+}
+
+// Half-extents on the screen of the footprint: J⁻¹ applied to the bound, per axis.
+vec2 footprint_extent(Footprint fp) {
+    vec3 m = fp.map;
+    return fp.bound * vec2(m.z + abs(m.y), abs(m.y) + m.x) / (m.x * m.z - m.y * m.y);
+}
+
+// The open interval of screen offsets d.x in row d.y that lie inside the footprint (empty
+// when lo ≥ hi): within both of J's rows' strips.
+vec2 footprint_row(Footprint fp, float dy) {
+    vec3 m = fp.map;
+    // (the same reciprocals for every row: a compiler computes them once)
+    vec2 x = vec2(-fp.bound - m.y * dy, fp.bound - m.y * dy) * (1.0 / m.x);
+    if (abs(m.y) > 1e-7) {
+        vec2 y = vec2(-fp.bound - m.z * dy, fp.bound - m.z * dy) * (1.0 / m.y);
+        y = m.y > 0.0 ? y : y.yx;
+        x = vec2(max(x.x, y.x), min(x.y, y.y));
+    } else if (abs(m.z * dy) >= fp.bound) {
+        x = vec2(0.0);
     }
-    if (c.x < 1.0) {
-        r = ceil((r + 1.0) * stretch) - 1.0;
+    return x;
+}
+
+// Inclusive pixel columns of row py (a pixel's centre is px + 0.5) inside the footprint of a
+// fragment centred at `centre`, clipped to the frame (x0 > x1: none).
+ivec2 footprint_columns(Footprint fp, vec2 centre, int py) {
+    vec2 x = footprint_row(fp, float(py) + 0.5 - centre.y) + centre.x - 0.5;
+    ivec2 p = ivec2(int(floor(x.x)) + 1, int(ceil(x.y)) - 1);
+    return ivec2(max(p.x, 0), min(p.y, int(frame.width) - 1));
+}
+
+// Inclusive rectangle (x0, y0, x1, y1) of the rows, and of the columns at most, whose pixels
+// the footprint can reach. Empty (x0 > x1) if off screen.
+ivec4 fragment_pixels(Fragment f, Footprint fp) {
+    vec2 h = footprint_extent(fp);
+    // Pixel px has centre px + 0.5; it is reached when |px + 0.5 − c| < h on both axes.
+    ivec2 p0 = ivec2(floor(f.center - 0.5 - h)) + 1;
+    ivec2 p1 = ivec2(ceil(f.center - 0.5 + h)) - 1;
+    p0 = max(p0, ivec2(0));
+    p1 = min(p1, ivec2(int(frame.width) - 1, int(frame.height) - 1));
+    if (p0.x > p1.x || p0.y > p1.y) {
+        return ivec4(0, 0, -1, -1);
     }
-    return size > 1u ? r + 0.5 : r;
+    return ivec4(p0, p1);
 }
 
 // Filtered texture reads the pixel walk (glsl/render/splat/convolve.comp) makes for one (pixel,
@@ -254,32 +310,21 @@ uint reads_per_evaluation(Fragment f, uint nodes) {
     return per_node * nodes;
 }
 
-// Inclusive rectangle (x0, y0, x1, y1) of the pixels whose centres lie within `reach` of the
-// fragment's centre on both axes (the convolution's reach test). Empty if off screen.
-ivec4 fragment_pixels(Fragment f) {
-    float reach = fragment_reach(f);
-    // Pixel px has centre px + 0.5; it is covered when |px + 0.5 - c| <= reach.
-    ivec2 p0 = ivec2(ceil(f.center - 0.5 - reach));
-    ivec2 p1 = ivec2(floor(f.center - 0.5 + reach));
-    p0 = max(p0, ivec2(0));
-    p1 = min(p1, ivec2(int(frame.width) - 1, int(frame.height) - 1));
-    if (p0.x > p1.x || p0.y > p1.y) {
-        return ivec4(0, 0, -1, -1);
-    }
-    return ivec4(p0, p1);
-}
-
-// Inclusive tile rectangle of `fragment_pixels`. Exact for the square kernel support.
-ivec4 tiles_of_pixels(ivec4 p) {
-    if (p.x > p.z) {
-        return p;
-    }
+// Per tile row ty of the footprint's rows, the inclusive range of tile columns whose pixels it
+// reaches (x > y: none): the union over the row's pixel rows of their columns, one interval
+// since the footprint is convex. tile_count and tile_fill take the same tiles from it.
+ivec2 footprint_tile_columns(Footprint fp, vec2 centre, ivec4 pixels, int ty) {
     int t = int(frame.tile_size);
-    return ivec4(p.xy / t, p.zw / t);
-}
-
-ivec4 fragment_tiles(Fragment f) {
-    return tiles_of_pixels(fragment_pixels(f));
+    int y0 = max(pixels.y, ty * t);
+    int y1 = min(pixels.w, ty * t + t - 1);
+    ivec2 span = ivec2(1 << 30, -1);
+    for (int py = y0; py <= y1; py++) {
+        ivec2 x = footprint_columns(fp, centre, py);
+        if (x.x <= x.y) {
+            span = ivec2(min(span.x, x.x), max(span.y, x.y));
+        }
+    }
+    return span.x <= span.y ? span / t : ivec2(0, -1);
 }
 
 #endif

@@ -175,10 +175,19 @@ pub fn render_binned(
                         let d = [(px - fx) as f64, (py - fy) as f64];
                         let r = radius_px[i];
                         let scaled = s.for_radius(r)[0] < 1.0;
+                        let [kx, ky] = s.kernel_offset(d, r);
+                        // A fragment joins the blend of the pixels its kernel reaches: off the
+                        // centre that is the kernel's square (bilinear reads reach one texel
+                        // past it) seen through the local scale, a parallelogram on the screen,
+                        // not the square around it, whose corners would split the pixel's depth
+                        // groups with fragments that add nothing.
+                        let bound = natural[i] as f64 + 1.0;
+                        if scaled && (kx.abs() >= bound || ky.abs() >= bound) {
+                            continue;
+                        }
                         for ((p, k), &c) in pixel.iter_mut().zip(kernel_of(i)).zip(&input.color[i])
                         {
                             let weight = if scaled {
-                                let [kx, ky] = s.kernel_offset(d, r);
                                 k.sample(kx, ky) * s.area_factor(r) as f32
                             } else {
                                 k.at(d[0] as i64, d[1] as i64)

@@ -818,17 +818,24 @@ fn every_pass_matches_its_cpu_step() {
     // The cost counters: pairs within reach, and the reads the pixel walk makes for them.
     let (mut evaluations, mut reads) = (0u64, 0u64);
     for f in gpu.fragments.iter().filter(|f| f.size > 0) {
-        if let Some([x0, y0, x1, y1]) = splat_cpu::reach_rect(&frame, f) {
-            let pairs = ((x1 - x0 + 1) * (y1 - y0 + 1)) as u64;
-            evaluations += pairs;
-            reads += pairs * splat_cpu::reads_per_evaluation(&frame, f, out.stats.layer_kernels);
-        }
+        let pairs = splat_cpu::reached_pixels(&frame, f).len() as u64;
+        evaluations += pairs;
+        reads += pairs * splat_cpu::reads_per_evaluation(&frame, f, out.stats.layer_kernels);
     }
-    assert_eq!(
-        out.stats.kernel_evaluations, evaluations,
-        "kernel evaluations"
+    // Off the centre the footprint's edge falls between pixel centres at irrational offsets, so
+    // a pixel within a rounding error of it may count on one side and not the other (the
+    // kernel is zero there); the square around it, the old count, is a quarter larger.
+    let near = |a: u64, b: u64| a.abs_diff(b) as f64 <= 1e-5 * b as f64 + 1.0;
+    assert!(
+        near(out.stats.kernel_evaluations, evaluations),
+        "kernel evaluations: {} on the GPU, {evaluations} here",
+        out.stats.kernel_evaluations
     );
-    assert_eq!(out.stats.texture_reads, reads, "texture reads");
+    assert!(
+        near(out.stats.texture_reads, reads),
+        "texture reads: {} on the GPU, {reads} here",
+        out.stats.texture_reads
+    );
     assert!(
         reads > evaluations,
         "the scene should exercise reads beyond one per pair ({reads} for {evaluations})"

@@ -57,8 +57,8 @@ const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
 // reads 16 bytes instead of the whole 48-byte fragment.
-shared vec4 batch_reach[64];   // centre.xy, reach, 1 when the local scale applies
-shared vec4 batch_scale[64];   // radial unit vector, radial and tangential shrink
+shared vec4 batch_reach[64];   // centre.xy, the footprint's bound in kernel space, unused
+shared vec4 batch_scale[64];   // the local scale's map J (J₁₁, J₁₂, J₂₂), 1 where it applies
 shared Fragment batch[64];
 shared uvec4 batch_nodes[64];  // off axis: the four field nodes around the fragment
 shared vec4 batch_node_weights[64];
@@ -146,19 +146,19 @@ vec3 fragment_weight(uint j, Fragment f, vec2 d) {
 }
 
 // Layered, a merged block in the wide field (block_reads in splat.glsl): its pixels'
-// kernels summed where they lie in kernel space, at kernel offset k of its centre; s: the
-// local scale (radial unit vector, radial and tangential shrink).
-vec3 wide_block_weight(Fragment f, vec2 k, vec4 s) {
+// kernels summed where they lie in kernel space, at kernel offset k of its centre; m: the
+// local scale's map J.
+vec3 wide_block_weight(Fragment f, vec2 k, vec3 m) {
     uint size = block_size(f);
     float layer = (f.index + 0.5) / float(textureSize(layer_texture, 0).z);
     if (size == 2u) {
-        // the four pixels at ±½ from the centre: offsets ±a, ±b in kernel space
-        vec2 a = kernel_offset(s.xy, s.zw, vec2(0.5, 0.5));
-        vec2 b = kernel_offset(s.xy, s.zw, vec2(0.5, -0.5));
+        // the four pixels at ±½ from the centre: offsets ±a = ±J·(½, ½), ±b = ±J·(½, −½)
+        vec2 a = 0.5 * vec2(m.x + m.y, m.y + m.z);
+        vec2 b = 0.5 * vec2(m.x - m.y, m.y - m.z);
         return layer_read(0u, k - a, vec2(0.0), layer) + layer_read(0u, k + a, vec2(0.0), layer)
              + layer_read(0u, k - b, vec2(0.0), layer) + layer_read(0u, k + b, vec2(0.0), layer);
     }
-    return float(size * size) * layer_box(k, block_box(size, s.xy, s.zw), layer);
+    return float(size * size) * layer_box(k, 0.5 * float(size) * m.xz, layer);
 }
 
 #include "blend.glsl"
@@ -211,30 +211,30 @@ void main() {
                 batch_nodes[local_index] = nodes;
                 batch_node_weights[local_index] = weights;
             }
-            vec3 s = local_scale(f.center);
-            // The largest channel radius decides how much of the local scale applies.
-            float r = max(f.radius.r, max(f.radius.g, f.radius.b));
-            vec2 c = shrink_for_radius(s.z, r);
-            batch_reach[local_index] = vec4(f.center, fragment_reach(f), c.x < 1.0 ? 1.0 : 0.0);
-            batch_scale[local_index] = vec4(s.xy, c);
+            Footprint fp = fragment_footprint(f);
+            batch_reach[local_index] = vec4(f.center, fp.bound, 0.0);
+            batch_scale[local_index] = vec4(fp.map, fragment_map(f).w);
         }
         barrier();
         uint batch_size = min(64u, n - start);
         for (uint j = 0u; j < batch_size; j++) {
             vec4 g = batch_reach[j];
+            vec4 m = batch_scale[j];
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
-                if (abs(d.x) > g.z || abs(d.y) > g.z) {
+                // The reach test in kernel space (footprint_reaches): off the centre the
+                // footprint is a parallelogram on the screen.
+                vec2 k = vec2(m.x * d.x + m.y * d.y, m.y * d.x + m.z * d.y);
+                if (abs(k.x) >= g.z || abs(k.y) >= g.z) {
                     continue;
                 }
                 Fragment f = batch[j];
                 vec3 w;
-                if (g.w > 0.5) {
-                    vec4 s = batch_scale[j];
-                    vec2 k = kernel_offset(s.xy, s.zw, d);
+                if (m.w > 0.5) {
                     w = LAYERED != 0u && block_size(f) > 1u && block_reads()
-                        ? wide_block_weight(f, k, s) : fragment_weight(j, f, k);
-                    w *= s.z * s.w;
+                        ? wide_block_weight(f, k, m.xyz) : fragment_weight(j, f, k);
+                    // the map's determinant: the kernel's weight per screen pixel
+                    w *= m.x * m.z - m.y * m.y;
                 } else {
                     w = fragment_weight(j, f, d);
                 }

@@ -79,9 +79,9 @@ const uint SLOTS = 96u;
 // Filtered reads per slot (two a slot measured 1.4× slower on lavapipe: most fragments' channels
 // span three radius levels).
 const uint READS = 3u;
-shared vec4 slot_reach[SLOTS];     // centre.xy, reach, the texture layer coordinate
-shared vec4 slot_scale[SLOTS];     // the local scale's map J (J₁₁, J₁₂, J₂₂; I: none), layered the
-                                   // read's code (layered_read), else 0
+shared vec4 slot_reach[SLOTS];     // centre.xy, the footprint's bound, the texture layer coordinate
+shared vec4 slot_scale[SLOTS];     // the local scale's map J (J₁₁, J₁₂, J₂₂; I: none), the read's
+                                   // code (read_code)
 shared vec4 slot_color[SLOTS];     // linear RGB, vergence (D)
 shared vec4 slot_read[SLOTS * READS]; // per read: its kernel's offset 0 (slot_point), bound, red coefficient
 shared vec4 slot_gb[SLOTS * 2u];   // green and blue coefficients of the three reads, then the
@@ -166,12 +166,12 @@ ReadPlan plan_reads(Fragment f, float pre) {
     return plan;
 }
 
-// Fills slot j with slot s of fragment f's plan; scale holds the radial unit vector and the
-// (radial, tangential) shrink, code the layered read's (layered_read).
-void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec4 scale, float post,
+// Fills slot j with slot s of fragment f's plan; map is the local scale's map J, code the
+// read's (read_code).
+void fill_slot(uint j, Fragment f, ReadPlan plan, uint s, vec4 reach, vec3 map, float post,
                float pixels, float code) {
     slot_reach[j] = reach;
-    slot_scale[j] = vec4(local_map(scale.xy, scale.zw), code);
+    slot_scale[j] = vec4(map, code);
     slot_color[j] = vec4(f.color, f.dioptre);
     slot_hidden[j] = uvec4(f.size, floatBitsToUint(f.radius));
     vec3 coef[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
@@ -260,7 +260,7 @@ vec3 layered_read(uint j, vec2 k, vec4 s, float layer, vec2 extent) {
     bool wide = kind > 4.5;
     bool box = wide && kind < 5.5;
     // Steps to the four reads, k ± a ± b: a 2×2 block's pixels lie at J·(±½, ±½), a box's
-    // corners at ±(s/2)·(J₁₁, J₂₂) (block_box).
+    // corners at ±(s/2)·(J₁₁, J₂₂).
     vec2 a = box ? vec2(0.5 * size * s.x, 0.0) : 0.5 * s.xy;
     vec2 b = box ? vec2(0.0, 0.5 * size * s.z) : 0.5 * s.yz;
     a = wide ? a : vec2(0.0);
@@ -305,11 +305,9 @@ vec3 slot_reads(uint j, vec4 gb0, vec4 gb1, vec2 d, vec2 node, float layer, vec2
          + one_read(j, 2u, gb1.xyz, d, node, layer, extent);
 }
 
-// Per-channel kernel weight of slot j at screen offset d: the local scale's kernel offset, the
+// Per-channel kernel weight of slot j at kernel offset k (s: the slot's J and code): the
 // reads, off axis the four field nodes mixed bilinearly.
-vec3 slot_weight(uint j, vec2 d, vec2 extent, float layer) {
-    vec4 s = slot_scale[j];
-    vec2 k = vec2(s.x * d.x + s.y * d.y, s.y * d.x + s.z * d.y);
+vec3 slot_weight(uint j, vec2 k, vec4 s, vec2 extent, float layer) {
     if (LAYERED != 0u && grouped) {
         // With the depth groups no weight follows the read: slot_gb is not loaded.
         return layered_read(j, k, s, layer, extent);
@@ -376,26 +374,23 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
         Fragment f;
         ReadPlan plan;
         vec4 reach;
-        vec4 scale;
+        Footprint fp;
         float post = 1.0;
         float pixels = 1.0;
         uint slots = 0u;
         bool wide_block = false;
         if (loaded) {
             f = load_fragment(entries[base + start + local_index].y);
-            vec3 s = local_scale(f.center);
-            // The largest channel radius decides how much of the local scale applies.
-            float rmax = max(f.radius.r, max(f.radius.g, f.radius.b));
-            vec2 c = shrink_for_radius(s.z, rmax);
-            bool scaled = c.x < 1.0;
-            reach = vec4(f.center, fragment_reach(f), (f.index + 0.5) / extent.z);
-            scale = scaled ? vec4(s.xy, c) : vec4(1.0, 0.0, 1.0, 1.0);
+            vec4 map = fragment_map(f);
+            bool scaled = map.w > 0.5;
+            fp = fragment_footprint(f);
+            reach = vec4(f.center, fp.bound, (f.index + 0.5) / extent.z);
             uint size = block_size(f);
             float n_px = float(size * size);
-            // Grouped, a merged block's light and the local scale's weight are linear factors
-            // of the reads; the per-fragment blend raises the summed weight to the block's
-            // pixel count first.
-            float local_weight = scaled ? c.x * c.y : 1.0;
+            // Grouped, a merged block's light and the local scale's weight (J's determinant)
+            // are linear factors of the reads; the per-fragment blend raises the summed weight
+            // to the block's pixel count first.
+            float local_weight = map.x * map.z - map.y * map.y;
             float pre = grouped ? (size > 1u ? n_px : 1.0) * local_weight : 1.0;
             post = grouped ? 1.0 : local_weight;
             pixels = !grouped && size > 1u ? n_px : 1.0;
@@ -422,10 +417,10 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
         // pixels' own test below is exact).
         if (fits) {
             atomicAdd(batch_taken, 1u);
-            float code = LAYERED != 0u ? read_code(block_size(f), wide_block) : 0.0;
+            float code = read_code(block_size(f), wide_block);
             [[unroll]] for (uint k = 0u; k < 3u; k++) {
                 if (k < slots) {
-                    fill_slot(first + k, f, plan, k, reach, scale, post, pixels, code);
+                    fill_slot(first + k, f, plan, k, reach, fp.map, post, pixels, code);
                 }
             }
             if (OFF_AXIS != 0u) {
@@ -454,16 +449,19 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
             uvec3 below_lo = mix(uvec3(0xFFFFFFFFu), (uvec3(1u) << lo) - 1u, lessThan(lo, uvec3(32u)));
             uvec3 bits = below_hi & ~below_lo;
             [[unroll]] for (uint p = 0u; p < 8u; p++) {
-                bool reached = false;
+                // Whether the footprint's columns in either of the patch's two rows meet its
+                // four columns (footprint_columns; no short-circuit: each `||` is a branch,
+                // which a CPU implementation's compiler is slow to take apart).
+                uint reached = 0u;
                 [[unroll]] for (uint k = 0u; k < PIXELS; k++) {
-                    // The patch's pixel centres span at … at + (3, 1).
-                    vec2 at = vec2(uvec2(tx, ty) * TILE + patch_origin(p)
-                                   + 8u * uvec2(k % PER_AXIS, k / PER_AXIS)) + 0.5;
-                    reached = reached
-                        || all(lessThanEqual(abs(clamp(reach.xy, at, at + PATCH - 1.0) - reach.xy),
-                                             vec2(reach.z)));
+                    ivec2 at = ivec2(uvec2(tx, ty) * TILE + patch_origin(p)
+                                     + 8u * uvec2(k % PER_AXIS, k / PER_AXIS));
+                    [[unroll]] for (int row = 0; row < 2; row++) {
+                        ivec2 x = footprint_columns(fp, f.center, at.y + row);
+                        reached |= uint(max(x.x, at.x) <= min(x.y, at.x + 3));
+                    }
                 }
-                if (reached) {
+                if (reached != 0u) {
                     atomicOr(patch_slots[p].x, bits.x);
                     atomicOr(patch_slots[p].y, bits.y);
                     atomicOr(patch_slots[p].z, bits.z);
@@ -485,10 +483,13 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
             todo.z = in_z ? todo.z & (todo.z - 1u) : todo.z;
             vec4 g = slot_reach[j];
             vec4 color = slot_color[j];
+            vec4 s = slot_scale[j];
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
-                if (abs(d.x) <= g.z && abs(d.y) <= g.z) {
-                    vec3 w = slot_weight(j, d, extent.xy, g.w);
+                // The footprint's test (fragment_footprint), in kernel space.
+                vec2 k = vec2(s.x * d.x + s.y * d.y, s.y * d.x + s.z * d.y);
+                if (abs(k.x) < g.z && abs(k.y) < g.z) {
+                    vec3 w = slot_weight(j, k, s, extent.xy, g.w);
                     uvec4 hidden = slot_hidden[j];
                     vec3 share = HIDDEN == 0u ? vec3(1.0)
                         : pupil_share(hidden.x, uintBitsToFloat(hidden.yzw),

@@ -41,9 +41,14 @@ void main() {
         Fragment f = load_fragment(p.y * frame.width + p.x);
         if (f.size != 0u) {
             atomicAdd(live_in_group, 1u);
-            ivec4 pixels = fragment_pixels(f);
-            if (pixels.x <= pixels.z) {
-                uint pairs = uint(pixels.z - pixels.x + 1) * uint(pixels.w - pixels.y + 1);
+            Footprint fp = fragment_footprint(f);
+            ivec4 pixels = fragment_pixels(f, fp);
+            uint pairs = 0u;
+            for (int py = pixels.y; py <= pixels.w; py++) {
+                ivec2 x = footprint_columns(fp, f.center, py);
+                pairs += uint(max(x.y - x.x + 1, 0));
+            }
+            if (pairs > 0u) {
                 uvec4 nodes;
                 vec4 weights;
                 field_corners(f.center, nodes, weights);
@@ -52,9 +57,10 @@ void main() {
                 atomicAdd(evaluations_in_group, pairs);
                 atomicAdd(reads_in_group, pairs * reads_per_evaluation(f, used));
             }
-            ivec4 tiles = tiles_of_pixels(pixels);  // the reach once per fragment
-            for (int ty = tiles.y; ty <= tiles.w; ty++) {
-                for (int tx = tiles.x; tx <= tiles.z; tx++) {
+            int t = int(frame.tile_size);
+            for (int ty = pixels.y / t; ty <= pixels.w / t && pixels.x <= pixels.z; ty++) {
+                ivec2 tiles = footprint_tile_columns(fp, f.center, pixels, ty);
+                for (int tx = tiles.x; tx <= tiles.y; tx++) {
                     atomicAdd(counts[uint(ty) * frame.tiles_x + uint(tx)], 1u);
                 }
             }

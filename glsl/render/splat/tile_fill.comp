@@ -30,12 +30,18 @@ void main() {
     if (f.size == 0u) {
         return;
     }
-    ivec4 tiles = fragment_tiles(f);
-    // Bands are whole tile rows: clip the rectangle to the band's rows.
+    Footprint fp = fragment_footprint(f);
+    ivec4 pixels = fragment_pixels(f, fp);
+    if (pixels.x > pixels.z) {
+        return;
+    }
+    // Bands are whole tile rows: clip the rows to the band's.
+    int t = int(frame.tile_size);
     int band_y0 = int(band.first_tile / frame.tiles_x);
     int band_y1 = int((band.end_tile - 1u) / frame.tiles_x);
-    for (int ty = max(tiles.y, band_y0); ty <= min(tiles.w, band_y1); ty++) {
-        for (int tx = tiles.x; tx <= tiles.z; tx++) {
+    for (int ty = max(pixels.y / t, band_y0); ty <= min(pixels.w / t, band_y1); ty++) {
+        ivec2 tiles = footprint_tile_columns(fp, f.center, pixels, ty);
+        for (int tx = tiles.x; tx <= tiles.y; tx++) {
             uint tile = uint(ty) * frame.tiles_x + uint(tx);
             uint slot = atomicAdd(cursors[tile], 1u);
             uint at = offsets[tile] - band.first_entry + slot;

@@ -184,40 +184,59 @@ pub fn merge_level(
     }
 }
 
-/// Inclusive pixel rectangle a fragment's kernel can reach (square support).
-pub fn reach_rect(frame: &Frame, f: &Fragment) -> Option<[i64; 4]> {
+/// The pixels a fragment's kernel can reach: those whose offset d from its centre maps to a
+/// kernel offset k = J·d with |k.x| and |k.y| below the kernel's bound (the square of its
+/// texels, read bilinearly, or of its block), where J is the local scale (I where none
+/// applies). Off the centre of a wide frame this is a parallelogram on the screen.
+pub fn reached_pixels(frame: &Frame, f: &Fragment) -> Vec<[i64; 2]> {
     let radius = f.radius.iter().fold(0.0f32, |a, &b| a.max(b));
-    let mut r = radius.ceil();
-    // Off the centre of a wide frame a kernel of radius ≥ 0.5 px stretches radially by up to
-    // 1/cos²θ (in full from 1.5 px), read bilinearly.
+    let r = radius.ceil();
+    // Off the centre a kernel of radius ≥ 0.5 px shrinks by (cos²θ, cos θ) radially and
+    // tangentially (in full from 1.5 px).
     let c = frame.cos_theta(f.center[0], f.center[1]);
     let t = (radius - 0.5).clamp(0.0, 1.0);
     let (cr, ct) = (1.0 + t * (c * c - 1.0), 1.0 + t * (c - 1.0));
-    // The extent of the square |k| < r + 1 under the inverse map along the screen axes.
-    let mut stretch = 1.0;
-    if cr < 1.0 {
+    let scaled = cr < 1.0;
+    let (j11, j12, j22) = if scaled {
         let u = f.center[0] - 0.5 * frame.width as f32;
         let v = f.center[1] - 0.5 * frame.height as f32;
         let rho = (u * u + v * v).sqrt();
         let (ex, ey) = (u / rho, v / rho);
-        let a = 1.0 / cr - 1.0 / ct;
-        let along = (ex * ex).max(ey * ey) + (ex * ey).abs();
-        stretch = 1.0 / ct + a * along;
-        r = ((r + 1.0) * stretch).ceil() - 1.0;
-    }
-    let reach = if f.size >= 4 {
-        // a block-summed kernel: (2r + s)² texels, non-zero within r + s/2 + ½
-        ((radius.ceil() + 0.5 * f.size as f32 + 0.5) * stretch - 0.5).ceil() - 0.5
-    } else if f.size > 1 {
-        r + 0.5
+        (
+            ct + (cr - ct) * ex * ex,
+            (cr - ct) * ex * ey,
+            ct + (cr - ct) * ey * ey,
+        )
     } else {
-        r
+        (1.0, 0.0, 1.0)
     };
-    let x0 = ((f.center[0] - 0.5 - reach).ceil() as i64).max(0);
-    let y0 = ((f.center[1] - 0.5 - reach).ceil() as i64).max(0);
-    let x1 = ((f.center[0] - 0.5 + reach).floor() as i64).min(frame.width as i64 - 1);
-    let y1 = ((f.center[1] - 0.5 + reach).floor() as i64).min(frame.height as i64 - 1);
-    (x0 <= x1 && y0 <= y1).then_some([x0, y0, x1, y1])
+    let wide_block = scaled && frame.block_reads;
+    let side = f.size as f32;
+    let bound = if f.size >= 4 {
+        // a block-summed kernel, (2r + s)² texels; in the wide field the box (s/2)·(J₁₁, J₂₂)
+        // moved over the plain kernel's texels
+        r + 0.5 + 0.5 * side * if wide_block { j11.max(j22) } else { 1.0 }
+    } else if f.size == 2 && wide_block {
+        // four reads at J·(±½, ±½)
+        r + 1.0 + 0.5 * (j12.abs() + j11.abs().max(j22.abs()))
+    } else {
+        r + 1.0
+    };
+    // J shrinks no offset by more than cos²θ: a square that surely holds the footprint.
+    let half = (bound / cr).ceil() as i64 + 1;
+    let (cx, cy) = (f.center[0].floor() as i64, f.center[1].floor() as i64);
+    let mut pixels = Vec::new();
+    for py in (cy - half).max(0)..=(cy + half).min(frame.height as i64 - 1) {
+        for px in (cx - half).max(0)..=(cx + half).min(frame.width as i64 - 1) {
+            let dx = px as f32 + 0.5 - f.center[0];
+            let dy = py as f32 + 0.5 - f.center[1];
+            let (kx, ky) = (j11 * dx + j12 * dy, j12 * dx + j22 * dy);
+            if kx.abs() < bound && ky.abs() < bound {
+                pixels.push([px, py]);
+            }
+        }
+    }
+    pixels
 }
 
 /// Continuous radius level: quarter pixels up to 2 px, whole pixels beyond (the PSF texture's
@@ -271,13 +290,14 @@ pub fn tile_lists(frame: &Frame, fragments: &[Fragment]) -> Vec<Vec<[u32; 2]>> {
         if f.size == 0 {
             continue;
         }
-        if let Some([x0, y0, x1, y1]) = reach_rect(frame, f) {
-            for ty in y0 / t..=y1 / t {
-                for tx in x0 / t..=x1 / t {
-                    lists[ty as usize * tiles_x + tx as usize]
-                        .push([f.depth.max(0.0).to_bits(), i as u32]);
-                }
-            }
+        let mut tiles: Vec<usize> = reached_pixels(frame, f)
+            .iter()
+            .map(|&[px, py]| (py / t) as usize * tiles_x + (px / t) as usize)
+            .collect();
+        tiles.sort_unstable();
+        tiles.dedup();
+        for tile in tiles {
+            lists[tile].push([f.depth.max(0.0).to_bits(), i as u32]);
         }
     }
     for list in &mut lists {
