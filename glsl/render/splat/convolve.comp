@@ -57,8 +57,8 @@ const uint PER_AXIS = TILE / 8u;
 const uint PIXELS = PER_AXIS * PER_AXIS;
 // The batch is split so that the reach test, which rejects most (pixel, fragment) pairs,
 // reads 16 bytes instead of the whole 48-byte fragment.
-shared vec4 batch_reach[64];   // centre.xy, the footprint's bound in kernel space, unused
-shared vec4 batch_scale[64];   // the local scale's map J (J₁₁, J₁₂, J₂₂), 1 where it applies
+shared vec4 batch_reach[64];   // centre.xy, the footprint's half-extents on the screen
+shared vec4 batch_scale[64];   // the local scale's map J (J₁₁, J₁₂, J₂₂), the footprint's bound
 shared Fragment batch[64];
 shared uvec4 batch_nodes[64];  // off axis: the four field nodes around the fragment
 shared vec4 batch_node_weights[64];
@@ -212,25 +212,30 @@ void main() {
                 batch_node_weights[local_index] = weights;
             }
             Footprint fp = fragment_footprint(f);
-            batch_reach[local_index] = vec4(f.center, fp.bound, 0.0);
-            batch_scale[local_index] = vec4(fp.map, fragment_map(f).w);
+            batch_reach[local_index] = vec4(f.center, footprint_extent(fp));
+            batch_scale[local_index] = vec4(fp.map, fp.bound);
         }
         barrier();
         uint batch_size = min(64u, n - start);
         for (uint j = 0u; j < batch_size; j++) {
             vec4 g = batch_reach[j];
-            vec4 m = batch_scale[j];
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
-                // The reach test in kernel space (footprint_reaches): off the centre the
-                // footprint is a parallelogram on the screen.
+                // The reach test: the footprint's bounding box on the screen, which rejects
+                // most pairs with one load, then the footprint itself in kernel space (off the
+                // centre a parallelogram on the screen).
+                if (abs(d.x) >= g.z || abs(d.y) >= g.w) {
+                    continue;
+                }
+                vec4 m = batch_scale[j];
                 vec2 k = vec2(m.x * d.x + m.y * d.y, m.y * d.x + m.z * d.y);
-                if (abs(k.x) >= g.z || abs(k.y) >= g.z) {
+                if (abs(k.x) >= m.w || abs(k.y) >= m.w) {
                     continue;
                 }
                 Fragment f = batch[j];
                 vec3 w;
-                if (m.w > 0.5) {
+                // J's diagonal falls below 1 where the local scale applies
+                if (m.x < 1.0 || m.z < 1.0) {
                     w = LAYERED != 0u && block_size(f) > 1u && block_reads()
                         ? wide_block_weight(f, k, m.xyz) : fragment_weight(j, f, k);
                     // the map's determinant: the kernel's weight per screen pixel
