@@ -198,7 +198,7 @@ vec3 pupil_share(uint size, vec3 radius, float inner, vec2 d) {
 // applies) are zero unless |k.x| and |k.y| are below its bound. Tested in kernel space, a
 // kernel off the centre of a wide frame covers the parallelogram J⁻¹·square on the screen;
 // the square around that, what the reach test was, holds up to twice as many pixels (a third
-// more over a 60° frame), all of them read as zeros and all of them splitting the pixel's depth
+// more over a 60° frame), each of them read as zeros and each able to split the pixel's depth
 // groups. One bound for both axes, so that a visit tests it without computing it.
 struct Footprint {
     vec3 map;     // J
