@@ -114,6 +114,16 @@ vec3 local_map(vec2 e, vec2 c) {
     return vec3(c.y + r * e.x * e.x, r * e.x * e.y, c.y + r * e.y * e.y);
 }
 
+// J·d for the map m = (J₁₁, J₁₂, J₂₂).
+vec2 map_offset(vec3 m, vec2 d) {
+    return vec2(m.x * d.x + m.y * d.y, m.y * d.x + m.z * d.y);
+}
+
+// det J: the kernel's weight per screen pixel (cos³θ in full).
+float map_area(vec3 m) {
+    return m.x * m.z - m.y * m.y;
+}
+
 // Whether a merged block in the wide field reads its pixels where they lie in kernel space
 // (glsl/common/layer_atlas.glsl: the layer kernels with the depth-group blend), rather than
 // one read that assumes them one texel apart (merge.comp bounds that read's misplacement).
@@ -197,9 +207,9 @@ vec3 pupil_share(uint size, vec3 radius, float inner, vec2 d) {
 // k = J·d of a screen offset d (J: the local scale's map, (J₁₁, J₁₂, J₂₂), I where none
 // applies) are zero unless |k.x| and |k.y| are below its bound. Tested in kernel space, a
 // kernel off the centre of a wide frame covers the parallelogram J⁻¹·square on the screen;
-// the square around that, what the reach test was, holds up to twice as many pixels (a third
-// more over a 60° frame), each of them read as zeros and each able to split the pixel's depth
-// groups. One bound for both axes, so that a visit tests it without computing it.
+// the square around that, what the reach test was, held 1.3 times as many pairs on colonnade's
+// 60° frame (validation.md, "The reach test in kernel space"), each extra one read as zeros
+// and able to split the pixel's depth groups. One bound for both axes, so that a visit tests it without computing it.
 struct Footprint {
     vec3 map;     // J
     float bound;  // exclusive half-side of the square in kernel space
@@ -233,16 +243,20 @@ vec4 fragment_map(Fragment f) {
     return c.x < 1.0 ? vec4(local_map(s.xy, c), 1.0) : vec4(1.0, 0.0, 1.0, 0.0);
 }
 
-Footprint fragment_footprint(Fragment f) {
-    vec4 j = fragment_map(f);
+// The footprint of fragment f whose map (fragment_map) is j.
+Footprint footprint_with_map(Fragment f, vec4 j) {
     return Footprint(j.xyz, footprint_bound(footprint_radius(f), j.xyz, block_size(f),
                                             j.w > 0.5 && block_reads()));
+}
+
+Footprint fragment_footprint(Fragment f) {
+    return footprint_with_map(f, fragment_map(f));
 }
 
 // Half-extents on the screen of the footprint: J⁻¹ applied to the bound, per axis.
 vec2 footprint_extent(Footprint fp) {
     vec3 m = fp.map;
-    return fp.bound * vec2(m.z + abs(m.y), abs(m.y) + m.x) / (m.x * m.z - m.y * m.y);
+    return fp.bound * vec2(m.z + abs(m.y), abs(m.y) + m.x) / map_area(m);
 }
 
 // The open interval of screen offsets d.x in row d.y that lie inside the footprint (empty

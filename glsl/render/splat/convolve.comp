@@ -228,7 +228,7 @@ void main() {
                     continue;
                 }
                 vec4 m = batch_scale[j];
-                vec2 k = vec2(m.x * d.x + m.y * d.y, m.y * d.x + m.z * d.y);
+                vec2 k = map_offset(m.xyz, d);
                 if (abs(k.x) >= m.w || abs(k.y) >= m.w) {
                     continue;
                 }
@@ -239,7 +239,7 @@ void main() {
                     w = LAYERED != 0u && block_size(f) > 1u && block_reads()
                         ? wide_block_weight(f, k, m.xyz) : fragment_weight(j, f, k);
                     // the map's determinant: the kernel's weight per screen pixel
-                    w *= m.x * m.z - m.y * m.y;
+                    w *= map_area(m.xyz);
                 } else {
                     w = fragment_weight(j, f, d);
                 }

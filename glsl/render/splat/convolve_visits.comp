@@ -351,7 +351,7 @@ vec3 slot_weight(uint j, vec2 k, vec4 s, vec2 extent, float layer) {
 // thread of a subgroup that one of its pixels reaches, and a small kernel's footprint covers
 // more of a 4 × 2 patch than of a row (a 5-pixel footprint fills 42 % of the rows it visits,
 // 52 % of the patches; the default render's convolution took 10 % less on lavapipe).
-const vec2 PATCH = vec2(4.0, 2.0);
+const ivec2 PATCH = ivec2(4, 2);
 uvec2 patch_origin(uint p) {
     return uvec2(4u * (p & 1u), 2u * (p >> 1u));
 }
@@ -383,14 +383,14 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
             f = load_fragment(entries[base + start + local_index].y);
             vec4 map = fragment_map(f);
             bool scaled = map.w > 0.5;
-            fp = fragment_footprint(f);
+            fp = footprint_with_map(f, map);
             reach = vec4(f.center, fp.bound, (f.index + 0.5) / extent.z);
             uint size = block_size(f);
             float n_px = float(size * size);
             // Grouped, a merged block's light and the local scale's weight (J's determinant)
             // are linear factors of the reads; the per-fragment blend raises the summed weight
             // to the block's pixel count first.
-            float local_weight = map.x * map.z - map.y * map.y;
+            float local_weight = map_area(map.xyz);
             float pre = grouped ? (size > 1u ? n_px : 1.0) * local_weight : 1.0;
             post = grouped ? 1.0 : local_weight;
             pixels = !grouped && size > 1u ? n_px : 1.0;
@@ -456,9 +456,9 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
                 [[unroll]] for (uint k = 0u; k < PIXELS; k++) {
                     ivec2 at = ivec2(uvec2(tx, ty) * TILE + patch_origin(p)
                                      + 8u * uvec2(k % PER_AXIS, k / PER_AXIS));
-                    [[unroll]] for (int row = 0; row < 2; row++) {
+                    [[unroll]] for (int row = 0; row < PATCH.y; row++) {
                         ivec2 x = footprint_columns(fp, f.center, at.y + row);
-                        reached |= uint(max(x.x, at.x) <= min(x.y, at.x + 3));
+                        reached |= uint(max(x.x, at.x) <= min(x.y, at.x + PATCH.x - 1));
                     }
                 }
                 if (reached != 0u) {
@@ -487,7 +487,7 @@ void walk_slots(uint n, uint base, uint tx, uint ty, vec3 extent) {
             [[unroll]] for (uint q = 0u; q < PIXELS; q++) {
                 vec2 d = centre[q] - g.xy;
                 // The footprint's test (fragment_footprint), in kernel space.
-                vec2 k = vec2(s.x * d.x + s.y * d.y, s.y * d.x + s.z * d.y);
+                vec2 k = map_offset(s.xyz, d);
                 if (abs(k.x) < g.z && abs(k.y) < g.z) {
                     vec3 w = slot_weight(j, k, s, extent.xy, g.w);
                     uvec4 hidden = slot_hidden[j];
