@@ -8,5 +8,5 @@
 #include "raster_shade.glsl"
 
 void main() {
-    shade_fragment();
+    shade_fragment(facet_toward_eye());
 }

@@ -3,7 +3,8 @@
 // A fragment survives when its vergence is smaller than the previous layer's at this pixel
 // by more than the gap (frame.ambient.w, dioptres: the blend's depth-group tolerance, so a
 // layer never repeats the surface in front of it), and when its surface faces the eye (the
-// back of an opaque object is never seen, from any point of the pupil).
+// back of an opaque object is never seen, from any point of the pupil; raster_shade.glsl's
+// seen_from_behind decides).
 #extension GL_GOOGLE_include_directive : require
 
 #include "raster_frame.glsl"
@@ -13,13 +14,14 @@ layout(binding = 2) uniform sampler2D previous_depth;
 #include "raster_shade.glsl"
 
 void main() {
+    vec3 facet = facet_toward_eye();
     float previous = texelFetch(previous_depth, ivec2(gl_FragCoord.xy), 0).r;
     float gap_d = frame.ambient.w;
     if (!(previous > 0.0) || isinf(previous) || 1.0 / fragment_view_depth() > 1.0 / previous - gap_d) {
         discard;
     }
-    if (dot(world_normal, frame.camera_position.xyz - world_position) < 0.0) {
+    if (seen_from_behind(world_normal)) {
         discard;
     }
-    shade_fragment();
+    shade_fragment(facet);
 }

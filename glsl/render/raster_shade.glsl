@@ -12,10 +12,24 @@ layout(push_constant) uniform Material {
     vec4 depth_range_m;
 } material;
 
-layout(location = 0) in vec3 world_position;
-layout(location = 1) in vec3 world_normal;
-layout(location = 2) in vec2 uv;
-layout(location = 3) in float view_depth;
+// Where a pixel's surface inputs are evaluated. With 4× MSAA this shader runs once per pixel
+// and its result goes to every sample the triangle covers; a plain input is interpolated at the
+// pixel's centre even where the centre lies outside the triangle, i.e. extrapolated past a
+// silhouette: position and depth run off the surface and the normal turns on past the rim
+// (docs/validation.md, "Silhouettes"). `centroid` evaluates them inside the covered samples,
+// so an edge pixel mixes colours and a depth that its surfaces really have.
+// raster_centre.frag defines PRE_SILHOUETTE_FIX: the old interpolation and the old two-sided
+// rule (below), kept only as the negative control of tests/it/silhouettes.rs.
+#ifdef PRE_SILHOUETTE_FIX
+#define SURFACE_INPUT in
+#else
+#define SURFACE_INPUT centroid in
+#endif
+
+layout(location = 0) SURFACE_INPUT vec3 world_position;
+layout(location = 1) SURFACE_INPUT vec3 world_normal;
+layout(location = 2) SURFACE_INPUT vec2 uv;
+layout(location = 3) SURFACE_INPUT float view_depth;
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
@@ -23,27 +37,53 @@ layout(location = 1) out float out_depth;
 const float PI = 3.14159265358979;
 
 // The fragment's view depth, kept within its object's box. A triangle seen edge-on (a facet on
-// a cylinder's silhouette) covers samples while its screen area is nearly zero; the
-// interpolation set up from that area is then meaningless, and a rasteriser returns any depth
-// for those samples (lavapipe gave 1.7 mm for a column 3.5 m away in the walk scene at 64×36,
-// which the nearest-sample resolve then kept). Whatever the driver does, a surface's depth
-// lies inside the box around its vertices; the clamp is inactive on every well-conditioned
-// fragment.
+// a silhouette) covers samples while its screen area is nearly zero; the interpolation set up
+// from that area is then meaningless, and a rasteriser returns any depth for those samples
+// (lavapipe gave 1.7 mm for a column 3.5 m away in the walk scene at 64×36, which the
+// nearest-sample resolve then kept). Centroid inputs do not cure this: on
+// tests/it/silhouettes.rs' scene at 320×180 one rim pixel of a sphere 0.52–0.68 m away still
+// read 0.347 m with them, the same as at the pixel centre. Whatever the driver does, a
+// surface's depth lies inside the box around its vertices; the clamp is inactive on every
+// well-conditioned fragment.
 float fragment_view_depth() {
     return clamp(view_depth, material.depth_range_m.x, material.depth_range_m.y);
 }
 
-void shade_fragment() {
+// The facet's own normal, turned toward the eye (zero where the facet is seen edge-on), for a
+// vertex normal that is missing. Call it before any discard: derivatives need the whole quad.
+vec3 facet_toward_eye() {
+    vec3 facet = cross(dFdx(world_position), dFdy(world_position));
+    return dot(facet, frame.camera_position.xyz - world_position) < 0.0 ? -facet : facet;
+}
+
+// Whether the eye sees the side of the surface its normal points away from (the back of an
+// object, or the far side of a two-sided sheet). The rasteriser's winding test decides: the
+// scene stores every triangle wound to agree with its normals (src/scene/mesh.rs), and
+// gl_FrontFacing is exact even on a facet seen edge-on. Judging by the view instead (the old
+// rule) flips a smooth surface's rim, whose interpolated normals legitimately turn past 90°
+// from the view before its polygonal silhouette, and lights a shadowed rim from the wrong
+// side; the facet's normal from screen derivatives is no better there, since centroid inputs
+// make those derivatives unreliable on the last pixels of a silhouette.
+bool seen_from_behind(vec3 n) {
+#ifdef PRE_SILHOUETTE_FIX
+    return dot(n, frame.camera_position.xyz - world_position) < 0.0;
+#else
+    return !gl_FrontFacing;
+#endif
+}
+
+// `facet`: facet_toward_eye(), taken where the whole quad was still running.
+void shade_fragment(vec3 facet) {
     vec3 n = world_normal;
     float len = length(n);
     if (len > 1e-20) {
         n /= len;
     } else {
         // Degenerate normal: fall back to the facet's own.
-        n = normalize(cross(dFdx(world_position), dFdy(world_position)));
+        n = normalize(facet);
     }
-    vec3 to_eye = frame.camera_position.xyz - world_position;
-    if (dot(n, to_eye) < 0.0) {
+    // Surfaces are two-sided: the side seen is lit.
+    if (seen_from_behind(n)) {
         n = -n;
     }
     vec3 albedo = material.albedo.rgb;

@@ -22,7 +22,7 @@ pub(crate) mod timeline;
 pub mod views;
 
 // Rasterising a scene into colour and depth.
-pub use raster::{Frame, Rasterizer, MSAA_SAMPLES};
+pub use raster::{Frame, Rasterizer, SurfaceInputs, MSAA_SAMPLES};
 // How layers of fragments are blended.
 pub use blend::{BlendMode, BlendSettings, DEFAULT_GROUP_TOLERANCE_D};
 // One frame from a scene and an eye: its kernels and its renderer.

@@ -21,6 +21,17 @@ use crate::image_io::{ImageGray, ImageRgba};
 use crate::scene::{FrameState, Light, Vertex, MAX_LIGHTS};
 use crate::{Error, Result};
 
+/// Where the fragment shader evaluates a pixel's surface inputs (position, normal, texture
+/// coordinates, depth); glsl/render/raster_shade.glsl says why it matters at silhouettes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceInputs {
+    /// Inside the samples the triangle covers (`centroid`): what every frame uses.
+    Covered,
+    /// At the pixel's centre, inside the triangle or not: extrapolated past silhouettes. The
+    /// behaviour before the fix, kept as a negative control for tests.
+    PixelCentre,
+}
+
 /// Samples per pixel.
 pub const MSAA_SAMPLES: u32 = 4;
 
@@ -150,8 +161,15 @@ pub struct Rasterizer {
 
 impl Rasterizer {
     pub fn new(ctx: &Context) -> Result<Rasterizer> {
-        let pipeline = Self::pipeline(ctx, false)?;
-        let peel = Self::pipeline(ctx, true)?;
+        Self::with_inputs(ctx, SurfaceInputs::Covered)
+    }
+
+    /// A rasteriser whose first layer interpolates the surface inputs as `inputs` says. Only
+    /// [`SurfaceInputs::Covered`] renders correctly; the other exists as the silhouette test's
+    /// negative control.
+    pub fn with_inputs(ctx: &Context, inputs: SurfaceInputs) -> Result<Rasterizer> {
+        let pipeline = Self::pipeline(ctx, false, inputs)?;
+        let peel = Self::pipeline(ctx, true, SurfaceInputs::Covered)?;
         let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
             .push_constants::<ResolvePush>()
             .build(ctx)?;
@@ -185,12 +203,15 @@ impl Rasterizer {
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
     /// layer's depth, `previous_depth` in glsl/render/raster_peel.frag).
-    fn pipeline(ctx: &Context, peel: bool) -> Result<GraphicsPipeline> {
+    fn pipeline(ctx: &Context, peel: bool, inputs: SurfaceInputs) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
-        let (name, fragment) = if peel {
-            ("raster peel", crate::shaders::RENDER_RASTER_PEEL_FRAG)
-        } else {
-            ("raster", crate::shaders::RENDER_RASTER_FRAG)
+        let (name, fragment) = match (peel, inputs) {
+            (true, _) => ("raster peel", crate::shaders::RENDER_RASTER_PEEL_FRAG),
+            (false, SurfaceInputs::Covered) => ("raster", crate::shaders::RENDER_RASTER_FRAG),
+            (false, SurfaceInputs::PixelCentre) => (
+                "raster (pixel-centre inputs)",
+                crate::shaders::RENDER_RASTER_CENTRE_FRAG,
+            ),
         };
         Ok(
             GraphicsPipeline::builder(name, crate::shaders::RENDER_RASTER_VERT, fragment)

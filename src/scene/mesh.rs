@@ -251,6 +251,19 @@ pub fn model_matrix(translate: [f64; 3], rotate_deg: [f64; 3], scale: [f64; 3]) 
     DMat4::from_translation(DVec3::from(translate)) * r * DMat4::from_scale(DVec3::from(scale))
 }
 
+/// Whether triangle `t`'s winding (counter-clockwise seen from where its normal points) agrees
+/// with its vertex normals. The rasteriser decides which side of a surface the eye sees by the
+/// winding (`gl_FrontFacing`), the one test that stays exact on a facet seen edge-on, so every
+/// triangle is stored wound to agree with its normals: OBJ windings are unreliable, and a
+/// placement's mirror (a negative scale) reverses them.
+fn winding_follows_normals(vertices: &[Vertex], t: [u32; 3]) -> bool {
+    let [a, b, c] = t.map(|i| vertices[i as usize]);
+    let p = |v: Vertex| DVec3::from(v.position_m.map(f64::from));
+    let n = |v: Vertex| DVec3::from(v.normal.map(f64::from));
+    let winding = (p(b) - p(a)).cross(p(c) - p(a));
+    winding.dot(n(a) + n(b) + n(c)) >= 0.0
+}
+
 impl Geometry {
     /// Places `mesh` with `model` and draws it with `material` (an index into `materials`).
     pub fn add(&mut self, mesh: &LocalMesh, model: &DMat4, material: usize) {
@@ -276,7 +289,13 @@ impl Geometry {
             });
         }
         let first_index = self.indices.len() as u32;
-        self.indices.extend(mesh.indices.iter().map(|i| i + base));
+        for t in mesh.indices.chunks_exact(3) {
+            let mut t = [t[0] + base, t[1] + base, t[2] + base];
+            if !winding_follows_normals(&self.vertices, t) {
+                t.swap(1, 2);
+            }
+            self.indices.extend_from_slice(&t);
+        }
         // One batch per placement, never merged with its neighbours: the rasteriser bounds each
         // fragment's depth by its batch's box, and a batch spanning a row of columns would
         // loosen that bound to the whole row.

@@ -57,6 +57,7 @@ mod real_inputs;
 mod rx_convention;
 mod scene;
 mod scenes_small;
+mod silhouettes;
 mod slices;
 mod splat;
 mod splat_presets;
