@@ -103,6 +103,25 @@ pub fn spectacle_to_pupil_rx(
     Ok(power_vector_to_rx(pv[0], pv[1], pv[2]))
 }
 
+/// The spectacle prescription `vertex_mm` in front of the cornea whose principal meridians,
+/// carried to the entrance pupil `pupil_behind_cornea_mm` behind the cornea, give the power
+/// vector (M, J0, J45): each meridian's power K at the pupil is F = K/(1 + dK) at the lens, d
+/// from the lens to the pupil (the inverse of [`spectacle_to_pupil_rx`]). Sphere, minus
+/// cylinder, axis. Paraxial: [`refract`] refines it by tracing through the lens.
+pub fn pupil_to_spectacle_rx(
+    pupil_power_vector: [f64; 3],
+    vertex_mm: f64,
+    pupil_behind_cornea_mm: f64,
+) -> (f64, f64, f64) {
+    let d_m = (vertex_mm + pupil_behind_cornea_mm) * 1e-3;
+    let [m, j0, j45] = pupil_power_vector;
+    let (s, c, a) = power_vector_to_rx(m, j0, j45);
+    let carry = |k: f64| k / (1.0 + d_m * k);
+    let (s1, s2) = (carry(s), carry(s + c));
+    let pv = rx_to_power_vector(s1, s2 - s1, a);
+    power_vector_to_rx(pv[0], pv[1], pv[2])
+}
+
 fn measure_far(
     eye: &Eye,
     pupil_mm: f64,
@@ -125,10 +144,8 @@ pub fn refract(
     bare.correction = None;
     let (r0, ep_z) = measure_far(&bare, pupil_mm, wavelength_nm)?;
     let d_m = (vertex_mm + ep_z) * 1e-3;
-    let (s, c, a) = power_vector_to_rx(r0.m, r0.j0, r0.j45);
-    let carry = |k: f64| k / (1.0 + d_m * k);
-    let (s1, s2) = (carry(s), carry(s + c));
-    let mut pv = rx_to_power_vector(s1, s2 - s1, a);
+    let (s1, c1, a1) = pupil_to_spectacle_rx([r0.m, r0.j0, r0.j45], vertex_mm, ep_z);
+    let mut pv = rx_to_power_vector(s1, c1, a1);
     let mut corrected = bare.clone();
     let mut residual = f64::INFINITY;
     let mut iterations = 0;

@@ -36,6 +36,17 @@ pub(crate) fn check_wavelength(option: &str, wavelength_nm: f64) -> Result<f64> 
         .map_err(Error::input)
 }
 
+/// `vertex_mm` as `--vertex-mm` takes it.
+fn check_vertex(vertex_mm: f64) -> PyResult<()> {
+    let (lo, hi) = crate::eye::correction::VERTEX_RANGE_MM;
+    if !(vertex_mm.is_finite() && (lo..=hi).contains(&vertex_mm)) {
+        return Err(value_error(format!(
+            "--vertex-mm: {vertex_mm} is outside {lo} to {hi} mm"
+        )));
+    }
+    Ok(())
+}
+
 fn check_field(field_deg: Option<(f64, f64)>) -> Result<Option<[f64; 2]>> {
     let Some((h, v)) = field_deg else {
         return Ok(None);
@@ -262,12 +273,7 @@ impl PyEye {
     /// with it.
     #[pyo3(signature = (rx, vertex_mm = 12.0))]
     fn with_correction(&self, rx: &str, vertex_mm: f64) -> PyResult<PyEye> {
-        let (lo, hi) = crate::eye::correction::VERTEX_RANGE_MM;
-        if !(vertex_mm.is_finite() && (lo..=hi).contains(&vertex_mm)) {
-            return Err(value_error(format!(
-                "--vertex-mm: {vertex_mm} is outside {lo} to {hi} mm"
-            )));
-        }
+        check_vertex(vertex_mm)?;
         let lens = crate::eye::correction::parse_rx(rx, vertex_mm)
             .map_err(|e| value_error(format!("--correct: {e}")))?;
         let mut eye = self.eye.clone();
@@ -284,29 +290,56 @@ impl PyEye {
         })
     }
 
-    /// The eye's refraction at its entrance pupil for a distant object: minimum-RMS
-    /// power vector (m, j0, j45) and the same as sphere, minus cylinder and axis.
-    #[pyo3(signature = (pupil_mm = 4.0, wavelength_nm = 549.0, field_deg = None))]
+    /// The spectacle prescription "S C x A" at `vertex_mm` in front of the cornea (0: a
+    /// contact lens) that corrects the eye for a distant object: what `ocular eye refract`
+    /// prints, and what `from_rx` and `with_correction` take (a correction the eye wears is
+    /// removed first). Beside it, the eye as given (its correction included) at its entrance
+    /// pupil: the minimum-RMS power vector `pupil_m_d`, `pupil_j0_d`, `pupil_j45_d`. At a
+    /// field angle the prescription is that power vector carried to the lens meridian by
+    /// meridian (paraxial; on axis it is traced through the lens).
+    #[pyo3(signature = (pupil_mm = 4.0, wavelength_nm = 549.0, field_deg = None, vertex_mm = 12.0))]
     fn refraction(
         &self,
         py: Python<'_>,
         pupil_mm: f64,
         wavelength_nm: f64,
         field_deg: Option<(f64, f64)>,
+        vertex_mm: f64,
     ) -> PyResult<PyRefraction> {
-        let m = guarded(py, || {
-            self.measure(pupil_mm, wavelength_nm, field_deg, None, 6)
+        check_vertex(vertex_mm)?;
+        let ((sphere_d, cylinder_d, axis_deg), pupil) = guarded(py, || {
+            let pupil = self
+                .measure(pupil_mm, wavelength_nm, field_deg, None, 6)?
+                .refraction;
+            let rx = match field_deg {
+                None => {
+                    let r =
+                        crate::eye::refract::refract(&self.eye, pupil_mm, vertex_mm, wavelength_nm)
+                            .map_err(|e| Error::input(format!("cannot refract the eye: {e}")))?;
+                    (r.sphere_d, r.cylinder_d, r.axis_deg)
+                }
+                Some(_) => {
+                    let mut bare = self.clone();
+                    bare.eye.correction = None;
+                    let m = bare.measure(pupil_mm, wavelength_nm, field_deg, None, 6)?;
+                    let r = m.refraction;
+                    crate::eye::refract::pupil_to_spectacle_rx(
+                        [r.m, r.j0, r.j45],
+                        vertex_mm,
+                        m.entrance_pupil_z_mm,
+                    )
+                }
+            };
+            Ok((rx, pupil))
         })?;
-        let r = m.refraction;
-        let (sphere_d, cylinder_d, axis_deg) =
-            crate::eye::refract::power_vector_to_rx(r.m, r.j0, r.j45);
         Ok(PyRefraction {
             sphere_d,
             cylinder_d,
             axis_deg,
-            m: r.m,
-            j0: r.j0,
-            j45: r.j45,
+            vertex_mm,
+            pupil_m_d: pupil.m,
+            pupil_j0_d: pupil.j0,
+            pupil_j45_d: pupil.j45,
             pupil_mm,
             wavelength_nm,
             field_deg,
@@ -355,16 +388,18 @@ impl PyEye {
     }
 }
 
-/// A refraction in clinical form and as a power vector (dioptres).
+/// A spectacle prescription at a vertex distance, and the eye's power vector at its entrance
+/// pupil beside it (dioptres).
 #[pyclass(name = "Refraction", module = "ocular_render", frozen, get_all)]
 #[derive(Clone)]
 pub struct PyRefraction {
     sphere_d: f64,
     cylinder_d: f64,
     axis_deg: f64,
-    m: f64,
-    j0: f64,
-    j45: f64,
+    vertex_mm: f64,
+    pupil_m_d: f64,
+    pupil_j0_d: f64,
+    pupil_j45_d: f64,
     pupil_mm: f64,
     wavelength_nm: f64,
     field_deg: Option<(f64, f64)>,
@@ -372,18 +407,21 @@ pub struct PyRefraction {
 
 #[pymethods]
 impl PyRefraction {
-    /// "S C x A", as `Eye.from_rx` and `Eye.with_correction` take it.
+    /// "S C x A" at `vertex_mm`, as `Eye.from_rx` and `Eye.with_correction` take it (with the
+    /// same `vertex_mm`).
     fn rx(&self) -> String {
         crate::eye::correction::format_rx(self.sphere_d, self.cylinder_d, self.axis_deg)
     }
 
     fn __repr__(&self) -> String {
         format!(
-            "<ocular_render.Refraction {} (M {:+.3} D, J0 {:+.3} D, J45 {:+.3} D) over {} mm at {} nm>",
+            "<ocular_render.Refraction {} at a {} mm vertex (entrance pupil: M {:+.3} D, J0 {:+.3} D, \
+             J45 {:+.3} D) over {} mm at {} nm>",
             self.rx(),
-            self.m,
-            self.j0,
-            self.j45,
+            self.vertex_mm,
+            self.pupil_m_d,
+            self.pupil_j0_d,
+            self.pupil_j45_d,
             self.pupil_mm,
             self.wavelength_nm
         )

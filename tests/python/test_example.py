@@ -26,7 +26,7 @@ def test_dataset_example_writes_eyes_and_frames(tmp_path, kernel_cache):
         # The prescription is a spectacle 12 mm in front of the eye (as `eye estimate --rx`
         # reads it): seen through it, the saved eye is emmetropic.
         c = eye.with_correction(entry["rx"]).refraction(pupil_mm=4.0, wavelength_nm=549.0)
-        assert max(abs(c.m), abs(c.j0), abs(c.j45)) < 0.12, (entry["rx"], c)
+        assert max(abs(c.pupil_m_d), abs(c.pupil_j0_d), abs(c.pupil_j45_d)) < 0.12, (entry["rx"], c)
         assert len(entry["frames"]) == 2
         for frame in entry["frames"]:
             image = oc.read_exr(tmp_path / "ds" / frame["image"])

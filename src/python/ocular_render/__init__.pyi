@@ -14,21 +14,25 @@ _F64 = npt.NDArray[np.float64]
 _Method = Literal["splat", "reference", "slices"]
 
 class Refraction:
-    """A refraction at the eye's entrance pupil: clinical form and power vector (D)."""
+    """A spectacle prescription at a vertex distance (what `ocular eye refract` prints), and
+    the eye's power vector at its entrance pupil beside it (D)."""
 
     sphere_d: float
     cylinder_d: float
     """Minus-cylinder form: ≤ 0."""
     axis_deg: float
     """1 to 180 degrees."""
-    m: float
-    j0: float
-    j45: float
+    vertex_mm: float
+    """Where the prescription's lens sits in front of the cornea (0: a contact lens)."""
+    pupil_m_d: float
+    """The eye as given (its correction included) at its entrance pupil: M."""
+    pupil_j0_d: float
+    pupil_j45_d: float
     pupil_mm: float
     wavelength_nm: float
     field_deg: Optional[Tuple[float, float]]
     def rx(self) -> str:
-        """"S C x A", as Eye.from_rx and Eye.with_correction take it."""
+        """"S C x A" at vertex_mm, as Eye.from_rx and Eye.with_correction take it."""
 
 class Eye:
     """A physical eye model (Navarro-based), optionally with the record of its fit."""
@@ -67,8 +71,11 @@ class Eye:
         pupil_mm: float = 4.0,
         wavelength_nm: float = 549.0,
         field_deg: Optional[Tuple[float, float]] = None,
+        vertex_mm: float = 12.0,
     ) -> Refraction:
-        """Minimum-RMS refraction for a distant object, on axis or at field (H, V) degrees."""
+        """The spectacle prescription at vertex_mm (0 to 16; 0: contact lens) that corrects
+        the eye for a distant object, as `ocular eye refract` prints it, with the eye's
+        minimum-RMS power vector at its entrance pupil (on axis or at field (H, V) degrees)."""
     def wavefront(
         self,
         pupil_mm: float = 4.0,
