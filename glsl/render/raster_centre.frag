@@ -1,6 +1,7 @@
 #version 460
 // raster.frag as it shaded silhouettes before the fix: inputs interpolated at the pixel centre
-// (no `centroid`) and the two-sided flip judged by the view (raster_shade.glsl). Built only so
+// (no `centroid`), the two-sided flip judged by the view and depths bounded by the object's box
+// alone (raster_shade.glsl). Built only so
 // that tests/it/silhouettes.rs can show its negative control failing; never used to render.
 
 #define PRE_SILHOUETTE_FIX

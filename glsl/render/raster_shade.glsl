@@ -18,8 +18,9 @@ layout(push_constant) uniform Material {
 // silhouette: position and depth run off the surface and the normal turns on past the rim
 // (docs/validation.md, "Silhouettes"). `centroid` evaluates them inside the covered samples,
 // so an edge pixel mixes colours and a depth that its surfaces really have.
-// raster_centre.frag defines PRE_SILHOUETTE_FIX: the old interpolation and the old two-sided
-// rule (below), kept only as the negative control of tests/it/silhouettes.rs.
+// raster_centre.frag defines PRE_SILHOUETTE_FIX: the old interpolation, the old two-sided rule
+// and the old depth bound (below), kept only as the negative control of
+// tests/it/silhouettes.rs.
 #ifdef PRE_SILHOUETTE_FIX
 #define SURFACE_INPUT in
 #else
@@ -30,23 +31,35 @@ layout(location = 0) SURFACE_INPUT vec3 world_position;
 layout(location = 1) SURFACE_INPUT vec3 world_normal;
 layout(location = 2) SURFACE_INPUT vec2 uv;
 layout(location = 3) SURFACE_INPUT float view_depth;
+layout(location = 4) flat in float vertex_view_depth;
+layout(location = 5) flat in float vertex_reach_m;
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
 
 const float PI = 3.14159265358979;
 
-// The fragment's view depth, kept within its object's box. A triangle seen edge-on (a facet on
-// a silhouette) covers samples while its screen area is nearly zero; the interpolation set up
-// from that area is then meaningless, and a rasteriser returns any depth for those samples
-// (lavapipe gave 1.7 mm for a column 3.5 m away in the walk scene at 64×36, which the
-// nearest-sample resolve then kept). Centroid inputs do not cure this: on
-// tests/it/silhouettes.rs' scene at 320×180 one rim pixel of a sphere 0.52–0.68 m away still
-// read 0.347 m with them, the same as at the pixel centre. Whatever the driver does, a
-// surface's depth lies inside the box around its vertices; the clamp is inactive on every
-// well-conditioned fragment.
+// The fragment's view depth, kept within what its triangle can have: within the reach of the
+// triangle's first vertex (no point of a triangle lies farther from a vertex than that
+// vertex's longest edge, src/scene/mesh.rs) and within its object's box. A triangle seen
+// edge-on (a facet on a silhouette) covers samples while its screen area is nearly zero; the
+// interpolation set up from that area is then ill-conditioned, and a rasteriser returns depths
+// off the surface even at covered samples, centroid or not: lavapipe gave 1.7 mm for a column
+// 3.5 m away in the walk scene at 64×36, and 0.183 m on the rim of the default frame's red
+// sphere, whose rim lies at 0.19–0.20 m. That pixel formed a depth group of its own in front
+// of the sphere, and its coverage drew the eye's PSF around it: a star. The bounds are
+// inactive on every well-conditioned fragment.
 float fragment_view_depth() {
+#ifdef PRE_SILHOUETTE_FIX
     return clamp(view_depth, material.depth_range_m.x, material.depth_range_m.y);
+#else
+    float d = view_depth;
+    if (abs(d - vertex_view_depth) > vertex_reach_m) {
+        // provably off the triangle: take the depth of its first vertex, which it has
+        d = vertex_view_depth;
+    }
+    return clamp(d, material.depth_range_m.x, material.depth_range_m.y);
+#endif
 }
 
 // The facet's own normal, turned toward the eye (zero where the facet is seen edge-on), for a

@@ -233,6 +233,11 @@ impl Rasterizer {
                             format: VertexFormat::Float2,
                             offset: 24,
                         },
+                        VertexAttribute {
+                            location: 3,
+                            format: VertexFormat::Float,
+                            offset: 32,
+                        },
                     ],
                 )
                 .push_constants::<MaterialPush>()

@@ -12,6 +12,10 @@ pub struct Vertex {
     pub position_m: [f32; 3],
     pub normal: [f32; 3],
     pub uv: [f32; 2],
+    /// The longest edge from this vertex in any of its triangles (m): no point of a triangle
+    /// lies farther from its vertex than this, so the rasteriser bounds a fragment's depth by
+    /// its triangle's first vertex (glsl/render/raster_shade.glsl).
+    pub reach_m: f32,
 }
 
 /// Lambertian surface: reflectance (linear RGB, 0..1) times an optional texture, plus emitted
@@ -286,6 +290,7 @@ impl Geometry {
                 position_m: p.as_vec3().to_array(),
                 normal: n.as_vec3().to_array(),
                 uv: mesh.uvs[i].map(|c| c as f32),
+                reach_m: 0.0,
             });
         }
         let first_index = self.indices.len() as u32;
@@ -295,6 +300,15 @@ impl Geometry {
                 t.swap(1, 2);
             }
             self.indices.extend_from_slice(&t);
+            let p = t.map(|i| DVec3::from(self.vertices[i as usize].position_m.map(f64::from)));
+            for k in 0..3 {
+                let reach = p[(k + 1) % 3]
+                    .distance(p[k])
+                    .max(p[(k + 2) % 3].distance(p[k]));
+                let v = &mut self.vertices[t[k] as usize];
+                // rounded up, so that the f32 bound holds what the f64 one does
+                v.reach_m = v.reach_m.max((reach * (1.0 + 1e-6)) as f32);
+            }
         }
         // One batch per placement, never merged with its neighbours: the rasteriser bounds each
         // fragment's depth by its batch's box, and a batch spanning a row of columns would

@@ -283,7 +283,7 @@ fn graphics_pipeline_checks_its_framebuffers() {
         ocular::shaders::RENDER_RASTER_FRAG,
     )
     .vertex_layout(
-        32,
+        36,
         &[
             VertexAttribute {
                 location: 0,
@@ -299,6 +299,12 @@ fn graphics_pipeline_checks_its_framebuffers() {
                 location: 2,
                 format: VertexFormat::Float2,
                 offset: 24,
+            },
+            // the vertex's reach (raster.vert)
+            VertexAttribute {
+                location: 3,
+                format: VertexFormat::Float,
+                offset: 32,
             },
         ],
     )
