@@ -20,7 +20,11 @@ void main() {
     if (!(previous > 0.0) || isinf(previous) || 1.0 / fragment_view_depth() > 1.0 / previous - gap_d) {
         discard;
     }
-    if (seen_from_behind(world_normal)) {
+    // A hidden layer keeps surfaces whose own normal faces the eye: it drops the far side of
+    // an object and also the last facets before a smooth object's silhouette, whose normals
+    // already turn away (the winding test of seen_from_behind would keep those, a few mm
+    // behind the rim the first layer holds, in place of the surface behind the rim).
+    if (dot(world_normal, frame.camera_position.xyz - world_position) < 0.0) {
         discard;
     }
     shade_fragment(facet);
