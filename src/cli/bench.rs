@@ -114,6 +114,9 @@ struct Report {
     height: u32,
     /// Depth layers splat took (1: the visible surface).
     layers: u32,
+    /// The `--quality` preset, and the settings it became with the options given.
+    quality: &'static str,
+    settings: crate::render::splat::SplatSettings,
     warmup: usize,
     frames: usize,
     focus_d: f64,
@@ -382,6 +385,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         println!("note: {n}");
     }
     let gap_d = splat.blend.group_tolerance_d;
+    let splat_settings = splat;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = frame.input(screen.fov_y_deg);
     let runs = if args.baseline { 2 } else { 1 };
@@ -431,6 +435,8 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         width,
         height,
         layers,
+        quality: args.splat.quality.name(),
+        settings: splat_settings,
         warmup: args.warmup,
         frames: args.frames,
         focus_d: eye_state.focus_d,

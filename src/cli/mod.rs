@@ -155,6 +155,13 @@ impl BlendArgs {
 /// The splatting options of render, bench and compare: one struct, flattened into each.
 #[derive(Debug, Clone, clap::Args)]
 pub struct SplatArgs {
+    /// Speed against accuracy: `exact` (no merging, no early exit: what the tests judge
+    /// against), `balanced` (merges only what cannot show) or `fast` (merges blocks as wide as
+    /// the blur under a 64× looser colour rule: 2.6–2.7× faster at 640×360 on lavapipe, 1.6–2.3 dB;
+    /// docs/quality.md).
+    /// The --merge-* options below refine the preset.
+    #[arg(long, value_enum, default_value = "balanced")]
+    pub quality: crate::render::splat::Quality,
     /// Screen tile side for splatting in pixels: 8, 16 or 32.
     #[arg(long, default_value_t = 8)]
     pub tile_size: u32,
@@ -162,54 +169,37 @@ pub struct SplatArgs {
     /// auto: rgba16f on a GPU, rgba32f on a CPU implementation (lavapipe), where it is faster.
     #[arg(long, value_enum, default_value = "auto")]
     pub texture_format: crate::render::splat::PsfTextureFormat,
-    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4 blocks, … 5 = up to 32×32.
-    /// A merged block reads its pixels' kernel summed over the block (exact for one colour).
-    #[arg(long, default_value_t = crate::render::splat::MergeSettings::DEFAULT_LEVELS)]
-    pub merge_levels: u32,
+    /// Fragment merging: 0 = off, 1 = 2×2 blocks, 2 = also 4×4 blocks, … 5 = up to 32×32
+    /// (preset: 0 for exact, else 5). A merged block reads its pixels' kernel summed over the
+    /// block (exact for one colour).
+    #[arg(long)]
+    pub merge_levels: Option<u32>,
     /// Level of detail by blur: merge a block of side s only where every kernel in it is at
-    /// least this many times s in radius (0 = any side, the seed paper's rule); its colours
-    /// must also agree within --merge-color-error and its depths within their tolerance.
-    #[arg(
-        long,
-        value_name = "K",
-        default_value_t = crate::render::splat::MergeSettings::DEFAULT_BLUR_PER_BLOCK,
-        allow_hyphen_values = true
-    )]
-    pub merge_blur_per_block: f32,
-    /// Merge a block only if its smallest blur radius is at least this (px).
-    #[arg(
-        long,
-        value_name = "PX",
-        default_value_t = 5.0,
-        allow_hyphen_values = true
-    )]
-    pub merge_min_radius: f32,
+    /// least this many times s in radius (preset: 2 balanced, 1 fast; 0 = any side, the seed
+    /// paper's rule); its colours must also agree within --merge-color-error and its depths
+    /// within their tolerance.
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub merge_blur_per_block: Option<f32>,
+    /// Merge a block only if its smallest blur radius is at least this (px; preset: 5
+    /// balanced, 1.5 fast).
+    #[arg(long, value_name = "PX", allow_hyphen_values = true)]
+    pub merge_min_radius: Option<f32>,
     /// The most that averaging one merged block's colours may change any pixel, block by block,
     /// as a fraction of the white the image is shown at (--exposure, else the frame's automatic
-    /// exposure; default 1/16320: a quarter of an 8-bit step shared by the 16 or so blocks a
-    /// kernel's rim crosses, since their errors add). A block of side s under blur radius r merges when its parts'
-    /// colours differ by at most 4π·E·(r/s)²: the wider the blur against the block, the
-    /// larger the difference that cannot show.
-    #[arg(
-        long,
-        value_name = "E",
-        default_value_t = crate::render::splat::MergeSettings::DEFAULT_COLOR_ERROR,
-        allow_hyphen_values = true
-    )]
-    pub merge_color_error: f32,
+    /// exposure; preset: balanced 1/16320, a quarter of an 8-bit step shared by the 16 or so
+    /// blocks a kernel's rim crosses, since their errors add; fast 1/255). A block of side s
+    /// under blur radius r merges when its parts' colours differ by at most 4π·E·(r/s)²: the
+    /// wider the blur against the block, the larger the difference that cannot show.
+    #[arg(long, value_name = "E", allow_hyphen_values = true)]
+    pub merge_color_error: Option<f32>,
     /// In the wide field, where a merged block makes one kernel read (with the radius levels
     /// or the per-fragment blend), the most (px) that read may misplace its edge pixels: off
     /// the centre a block's pixels lie cos²θ·δ apart in kernel space, not δ, so a block of side
     /// s merges only where (1 − cos²θ)·s/2 is at most this (default 0.02; 0 merges only at the
     /// centre of the frame; a large value ignores the local scale). With the layer kernels and
     /// depth groups (the default) a merged block reads its pixels where they lie: no bound.
-    #[arg(
-        long,
-        value_name = "PX",
-        default_value_t = crate::render::splat::MergeSettings::DEFAULT_SCALE_ERROR_PX,
-        allow_hyphen_values = true
-    )]
-    pub merge_scale_error: f32,
+    #[arg(long, value_name = "PX", allow_hyphen_values = true)]
+    pub merge_scale_error: Option<f32>,
     /// Read kernels at the radius levels around each fragment's radius (up to three filtered
     /// reads per pixel and fragment) instead of each object distance's own kernel (one read).
     /// By default the layer kernels are used where neighbouring distances' radii differ by at
@@ -226,22 +216,25 @@ pub struct SplatArgs {
 }
 
 impl SplatArgs {
-    /// The validated settings; errors name the options.
+    /// The validated settings: the preset, refined by the options given; errors name the
+    /// options.
     pub(crate) fn settings(&self) -> Result<crate::render::splat::SplatSettings> {
+        let preset = self.quality.settings();
+        let merge = preset.merge;
         let settings = crate::render::splat::SplatSettings {
             tile_size: self.tile_size,
             texture_format: self.texture_format,
             merge: crate::render::splat::MergeSettings {
-                levels: self.merge_levels,
-                blur_per_block: self.merge_blur_per_block,
-                min_radius_px: self.merge_min_radius,
-                color_error: self.merge_color_error,
-                scale_error_px: self.merge_scale_error,
-                ..crate::render::splat::MergeSettings::default()
+                levels: self.merge_levels.unwrap_or(merge.levels),
+                blur_per_block: self.merge_blur_per_block.unwrap_or(merge.blur_per_block),
+                min_radius_px: self.merge_min_radius.unwrap_or(merge.min_radius_px),
+                color_error: self.merge_color_error.unwrap_or(merge.color_error),
+                scale_error_px: self.merge_scale_error.unwrap_or(merge.scale_error_px),
+                ..merge
             },
             blend: self.blend.settings(),
             layer_kernels: !self.level_kernels,
-            ..crate::render::splat::SplatSettings::default()
+            ..preset
         };
         settings.validate().map_err(|e| {
             crate::Error::input(format!(

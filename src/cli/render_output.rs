@@ -35,6 +35,8 @@ pub(super) struct Summary {
     /// Things about the input a user should know (also printed on stderr).
     warnings: Vec<String>,
     method: &'static str,
+    /// The `--quality` preset splat rendered at (its settings: `ocular bench --json`).
+    quality: &'static str,
     seconds_render: f64,
     seconds_kernels: f64,
     kernels_from_cache: bool,
@@ -118,6 +120,7 @@ pub(super) fn finish(
         pupil_source,
         warnings: input.warnings.clone(),
         method: args.method.name(),
+        quality: args.splat.quality.name(),
         seconds_render: frame.seconds,
         seconds_kernels,
         kernels_from_cache: from_cache,

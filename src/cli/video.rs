@@ -25,7 +25,6 @@ use crate::gpu::Context;
 use crate::image_io::{self, Tonemap, TonemapMode};
 use crate::render::frame::FrameRenderer;
 use crate::render::frame_plan::load_eye;
-use crate::render::splat::SplatSettings;
 use crate::render::timeline::{animation_needs, planning_frames, Timeline};
 use crate::render::Rasterizer;
 use crate::scene::Scene;
@@ -101,6 +100,10 @@ pub struct VideoArgs {
     /// the eye traced for its own direction, mixed from a lattice planned from the frame.
     #[arg(long)]
     pub off_axis: bool,
+    /// Speed against accuracy: exact, balanced or fast (as `render --quality`;
+    /// docs/quality.md).
+    #[arg(long, value_enum, default_value = "balanced")]
+    pub quality: crate::render::splat::Quality,
     /// Depth layers splat takes (1–8; default 1): each frame is depth-peeled to K layers, and
     /// hidden surfaces show through blurred edges where the pupil sees past them (as `render
     /// --layers`).
@@ -304,7 +307,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         // The merge's colour bound is a fraction of the white the frames are shown at: frame
         // 0's automatic exposure unless --exposure fixes it (EXR frames too, where it is how
         // they would be viewed).
-        let mut splat = SplatSettings::default();
+        let mut splat = args.quality.settings();
         if let Some(ev) = exposure_ev {
             splat.merge.white = crate::render::splat::display_white(ev);
         }
@@ -395,7 +398,7 @@ fn export_config(
     (width, height): (u32, u32),
     options: &crate::render::frame::KernelOptions,
 ) -> Result<ExportConfig> {
-    let splat = SplatSettings::default();
+    let splat = args.quality.settings();
     let planned = planning_frames(timeline.count);
     let mut parts: Vec<&dyn std::fmt::Debug> = vec![
         &options.settings,

@@ -24,6 +24,20 @@ pub(super) struct Options {
     pub(super) off_axis: bool,
     /// The exposure the image will be shown at (EV; None: the frame's automatic one).
     pub(super) exposure_ev: Option<f64>,
+    /// The speed/accuracy preset (`--quality`).
+    pub(super) quality: crate::render::splat::Quality,
+}
+
+fn parse_quality(name: &str) -> Result<crate::render::splat::Quality> {
+    use crate::render::splat::Quality;
+    match name.trim().to_ascii_lowercase().as_str() {
+        "exact" => Ok(Quality::Exact),
+        "balanced" => Ok(Quality::Balanced),
+        "fast" => Ok(Quality::Fast),
+        _ => Err(Error::input(format!(
+            "--quality {name:?} is not one of exact, balanced, fast"
+        ))),
+    }
 }
 
 fn parse_method(name: &str) -> Result<Method> {
@@ -52,7 +66,9 @@ pub(super) fn options(
     layers: u32,
     off_axis: bool,
     exposure_ev: Option<f64>,
+    quality: &str,
 ) -> Result<Options> {
+    let quality = parse_quality(quality)?;
     let given = [focus_m.is_some(), focus_d.is_some(), focus_at.is_some()];
     if given.iter().filter(|g| **g).count() > 1 {
         return Err(Error::input(
@@ -113,6 +129,7 @@ pub(super) fn options(
         layers,
         off_axis,
         exposure_ev,
+        quality,
     })
 }
 

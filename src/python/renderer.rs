@@ -118,7 +118,7 @@ impl PyRenderer {
             fov_y_deg: frame.fov_y_deg,
             height_px: frame.height,
             field_width_px: options.field_width_px,
-            splat: SplatSettings::default(),
+            splat: o.quality.settings(),
         };
         let needs = frame.needs(state);
         let planned = crate::psf::plan::plan_for_scene(&needs, &options.reference_for(&needs))
@@ -327,7 +327,7 @@ impl PyRenderer {
 
     /// `color` (H, W, 3) float32 linear RGB and `depth` (H, W) float32 metres along the view
     /// axis (0 or inf: background) as `eye` sees them; returns (H, W, 3) float32.
-    #[pyo3(signature = (eye, color, depth, *, fov_y_deg, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None))]
+    #[pyo3(signature = (eye, color, depth, *, fov_y_deg, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None, quality = "balanced"))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -346,6 +346,7 @@ impl PyRenderer {
         layers: u32,
         off_axis: bool,
         exposure_ev: Option<f64>,
+        quality: &str,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let o = options(
             focus_m,
@@ -358,6 +359,7 @@ impl PyRenderer {
             layers,
             off_axis,
             exposure_ev,
+            quality,
         )
         .map_err(super::to_py)?;
         crate::limits::FOV_Y_DEG
@@ -386,7 +388,7 @@ impl PyRenderer {
 
     /// A shipped scene (`scenes()`) or a scene .toml file as `eye` sees it; returns
     /// (H, W, 3) float32 linear RGB. Focus and pupil default to the scene's.
-    #[pyo3(signature = (scene, eye, *, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None))]
+    #[pyo3(signature = (scene, eye, *, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None, quality = "balanced"))]
     #[allow(clippy::too_many_arguments)]
     fn render_scene<'py>(
         &self,
@@ -405,6 +407,7 @@ impl PyRenderer {
         layers: u32,
         off_axis: bool,
         exposure_ev: Option<f64>,
+        quality: &str,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
         let o = options(
             focus_m,
@@ -417,6 +420,7 @@ impl PyRenderer {
             layers,
             off_axis,
             exposure_ev,
+            quality,
         )
         .map_err(super::to_py)?;
         let eye = eye.eye.clone();

@@ -50,6 +50,7 @@ mod plane_four_eyes;
 mod psf_cache;
 mod psf_grid;
 mod psf_true_kernels;
+mod quality;
 mod radius_levels;
 mod raster;
 mod raster_hdr;

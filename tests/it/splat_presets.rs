@@ -15,13 +15,13 @@ use ocular::render::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, KernelOptions, Method,
 };
 
-const W: u32 = 96;
-const H: u32 = 54;
+pub(crate) const W: u32 = 96;
+pub(crate) const H: u32 = 54;
 /// A narrow field, so that the near planes blur by 10 px and more (enough to tell methods
 /// apart) on a small frame.
-const FOV_Y_DEG: f64 = 3.0;
+pub(crate) const FOV_Y_DEG: f64 = 3.0;
 
-fn layered() -> (Vec<[f32; 4]>, Vec<f32>) {
+pub(crate) fn layered() -> (Vec<[f32; 4]>, Vec<f32>) {
     let mut color = Vec::new();
     let mut depth = Vec::new();
     for y in 0..H {

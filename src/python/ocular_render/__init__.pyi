@@ -152,6 +152,7 @@ class Renderer:
         layers: int = 1,
         off_axis: bool = False,
         exposure_ev: Optional[float] = None,
+        quality: Literal["exact", "balanced", "fast"] = "balanced",
     ) -> _F32:
         """color (H, W, 3) or (L, H, W, 3) float32, depth (H, W) or (L, H, W) float32 metres
         → (H, W, 3) float32, as `ocular render --color --depth` renders them."""
@@ -172,6 +173,7 @@ class Renderer:
         layers: int = 1,
         off_axis: bool = False,
         exposure_ev: Optional[float] = None,
+        quality: Literal["exact", "balanced", "fast"] = "balanced",
     ) -> _F32:
         """A shipped scene or scene .toml file as the eye sees it (size is (W, H))."""
     def rasterize(

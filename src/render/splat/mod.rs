@@ -46,7 +46,7 @@ use bands::{plan_bands, BandPush, BandSlot, PlannedBands};
 pub use input::{RecordedInput, RecordedLayer};
 pub use psf_texture::PsfTextureFormat;
 pub use settings::{
-    display_white, ConvolveWalk, MergeSettings, SplatSettings, DEFAULT_SATURATION_EPSILON,
+    display_white, ConvolveWalk, MergeSettings, Quality, SplatSettings, DEFAULT_SATURATION_EPSILON,
 };
 use uniform::FrameBlock;
 pub(crate) use uniform::FrameUniform;

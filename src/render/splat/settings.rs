@@ -124,6 +124,71 @@ pub struct SplatSettings {
     pub layer_kernels: bool,
 }
 
+/// The speed/accuracy ladder a user picks from (`--quality`); the expert options (`--merge-*`,
+/// `--level-kernels`, …) refine the preset they start from. docs/quality.md measures the trade.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Quality {
+    /// No approximation the engine can avoid: no merging, no early exit. What the tests judge
+    /// the others against; its cost grows as pixels × blur².
+    Exact,
+    /// Merges blocks only where the averaged colours cannot show (a quarter of an 8-bit step
+    /// shared along a kernel's rim) and no block is wider than half the blur: within 0.5 dB of
+    /// `exact` (0.00–0.13 dB measured, docs/quality.md).
+    #[default]
+    Balanced,
+    /// Merges blocks as wide as the blur from 1.5 px of blur on, wherever colours agree to an
+    /// 8-bit step shared along the rim (a 64× looser colour rule): 2.6–2.7× faster than
+    /// `balanced` at 640×360 on lavapipe, for 1.6–2.3 dB against the exact reference
+    /// (docs/quality.md).
+    Fast,
+}
+
+impl Quality {
+    /// The settings the preset starts from.
+    pub fn settings(self) -> SplatSettings {
+        let base = SplatSettings::default();
+        match self {
+            Quality::Exact => SplatSettings {
+                merge: MergeSettings {
+                    levels: 0,
+                    ..base.merge
+                },
+                saturation_epsilon: 0.0,
+                ..base
+            },
+            Quality::Balanced => base,
+            Quality::Fast => SplatSettings {
+                merge: MergeSettings {
+                    blur_per_block: 1.0,
+                    min_radius_px: 1.5,
+                    color_error: 1.0 / 255.0,
+                    ..base.merge
+                },
+                ..base
+            },
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Quality::Exact => "exact",
+            Quality::Balanced => "balanced",
+            Quality::Fast => "fast",
+        }
+    }
+}
+
 /// Largest radius step (px) between neighbouring object distances at which the layer kernels
 /// are used: the filter between two distances then blends kernels whose edges lie at most this
 /// far apart, where the radius levels blend kernels a whole pixel apart (above 2 px).
