@@ -130,12 +130,13 @@ struct Targets {
     height: u32,
     color_ms: Image,
     depth_ms: Image,
-    view_depth_ms: Image,
+    /// View depth per sample, two of them: layer k is drawn into `view_depth_ms[k % 2]`, and
+    /// the peel that draws layer k + 1 reads layer k's samples from the other.
+    view_depth_ms: [Image; 2],
     color: Image,
     framebuffer: Framebuffer,
-    /// The same targets for the peeling pipeline, and the previous layer's depth it reads.
-    peel_framebuffer: Framebuffer,
-    previous_depth: Image,
+    /// The same targets for the peeling pipeline, one per view-depth image it draws into.
+    peel_framebuffers: [Framebuffer; 2],
     /// The resolved depth (view-axis metres, row-major), on the device.
     depth: Buffer,
     /// Persistent read-back buffers (colour, depth) of the host path (`render`,
@@ -202,7 +203,7 @@ impl Rasterizer {
     }
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
-    /// layer's depth, `previous_depth` in glsl/render/raster_peel.frag).
+    /// layer's samples, `previous_samples` in glsl/render/raster_peel.frag).
     fn pipeline(ctx: &Context, peel: bool, inputs: SurfaceInputs) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
         let (name, fragment) = match (peel, inputs) {
@@ -313,11 +314,18 @@ impl Rasterizer {
             TexelFormat::Rgba32Float,
             attachment(false, false, MSAA_SAMPLES),
         )?;
-        let view_depth_ms = target(
-            "raster view depth (MSAA)",
-            TexelFormat::R32Float,
-            attachment(false, true, MSAA_SAMPLES),
-        )?;
+        let view_depth_ms = [
+            target(
+                "raster view depth (MSAA, even layers)",
+                TexelFormat::R32Float,
+                attachment(false, true, MSAA_SAMPLES),
+            )?,
+            target(
+                "raster view depth (MSAA, odd layers)",
+                TexelFormat::R32Float,
+                attachment(false, true, MSAA_SAMPLES),
+            )?,
+        ];
         let depth_ms = target(
             "raster depth buffer (MSAA)",
             TexelFormat::D32Float,
@@ -334,33 +342,26 @@ impl Rasterizer {
         )?;
         let framebuffer = self.pipeline.framebuffer(
             ctx,
-            &[&color_ms, &view_depth_ms],
+            &[&color_ms, &view_depth_ms[0]],
             &[&color],
             Some(&depth_ms),
         )?;
-        let peel_framebuffer = self.peel.framebuffer(
-            ctx,
-            &[&color_ms, &view_depth_ms],
-            &[&color],
-            Some(&depth_ms),
-        )?;
-        // storage: where peeled layers stay on the GPU, splat's input pass writes it
-        let previous_depth = target(
-            "raster previous layer depth",
-            TexelFormat::R32Float,
-            ImageUsage {
-                storage: true,
-                ..ImageUsage::SAMPLED
-            },
-        )?;
+        let peel_framebuffer = |k: usize| {
+            self.peel.framebuffer(
+                ctx,
+                &[&color_ms, &view_depth_ms[k]],
+                &[&color],
+                Some(&depth_ms),
+            )
+        };
+        let peel_framebuffers = [peel_framebuffer(0)?, peel_framebuffer(1)?];
         let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
             depth: Buffer::new(ctx, "raster depth", pixels * 4, Residency::Device)?,
             readback: None,
             width,
             height,
-            peel_framebuffer,
-            previous_depth,
+            peel_framebuffers,
             color_ms,
             depth_ms,
             view_depth_ms,
@@ -421,8 +422,8 @@ impl Rasterizer {
     /// The first `layers` surfaces along each pixel's ray (depth peeling), nearest first.
     /// Layer 0 is [`Rasterizer::render`]'s frame; in the others a pixel with no surface has
     /// colour 0 and depth +∞, and a surface lies behind the previous layer's by more than
-    /// `gap_d` dioptres (the blend's depth-group tolerance) and faces the eye. Edge pixels
-    /// hold the hidden surface's own colour (coverage divided out).
+    /// `gap_d` dioptres (the blend's depth-group tolerance) and faces the eye, sample by
+    /// sample. Edge pixels hold the hidden surface's own colour (coverage divided out).
     pub fn render_layers(
         &mut self,
         ctx: &Context,
@@ -434,21 +435,15 @@ impl Rasterizer {
         let camera = &state.camera;
         let view_proj = self.view_projection(camera, f64::from(width) / f64::from(height));
         let mut frames = vec![self.render(ctx, state, width, height)?];
-        for _ in 1..layers {
-            let previous = &frames.last().expect("layer 0 is there").depth_m;
-            // layer 0's background (the far plane) hides nothing
-            let far = camera.far_m as f32;
-            let previous: Vec<f32> = previous
-                .iter()
-                .map(|&d| if d >= far { f32::INFINITY } else { d })
-                .collect();
+        let far = camera.far_m as f32;
+        for layer in 1..layers {
             let mut frame = self.draw(
                 ctx,
                 state,
                 (width, height),
                 view_proj,
                 camera.position_m,
-                Some((&previous, gap_d)),
+                Some((layer, gap_d)),
             )?;
             for (c, d) in frame.color.iter_mut().zip(frame.depth_m.iter_mut()) {
                 if c[3] > 1e-6 && *d < far {
@@ -470,7 +465,7 @@ impl Rasterizer {
         (width, height): (u32, u32),
         view_proj: glam::DMat4,
         eye_position_m: [f64; 3],
-        peel: Option<(&[f32], f32)>,
+        peel: Option<(u32, f32)>,
     ) -> Result<Frame> {
         let gap_d = peel.map(|(_, gap)| gap);
         self.prepare(
@@ -501,11 +496,9 @@ impl Rasterizer {
         }
         let targets = self.targets.as_ref().expect("prepared");
         let (color_readback, depth_readback) = targets.readback.as_ref().expect("made above");
-        if let Some((previous, _)) = peel {
-            targets.previous_depth.upload(ctx, previous)?;
-        }
+        let layer = peel.map_or(0, |(layer, _)| layer);
         let timings = ctx.submit(|rec| {
-            self.record(rec, state, peel.is_some())?;
+            self.record(rec, state, layer)?;
             rec.begin_pass("read back");
             rec.copy_image_to_buffer(&targets.color, color_readback);
             rec.copy_buffer(&targets.depth, depth_readback, targets.depth.size_bytes());
@@ -595,14 +588,16 @@ impl Rasterizer {
         &self,
         rec: &mut Recorder<'_>,
         state: &FrameState<'_>,
-        peel: bool,
+        layer: u32,
     ) -> crate::gpu::GpuResult<()> {
         let gpu_scene = self.scene.as_ref().expect("prepared");
         let targets = self.targets.as_ref().expect("prepared");
         let (width, height) = (targets.width, targets.height);
         let bg = state.scene.background_rgb;
+        let peel = layer > 0;
+        let (this, previous) = ((layer % 2) as usize, ((layer + 1) % 2) as usize);
         let (pipeline, framebuffer, clear) = if peel {
-            (&self.peel, &targets.peel_framebuffer, [0.0; 4])
+            (&self.peel, &targets.peel_framebuffers[this], [0.0; 4])
         } else {
             (
                 &self.pipeline,
@@ -649,8 +644,8 @@ impl Rasterizer {
                 .read("albedo_map", (texture, &self.texture_sampler));
             if peel {
                 bound = bound.read(
-                    "previous_depth",
-                    (&targets.previous_depth, &self.point_sampler),
+                    "previous_samples",
+                    (&targets.view_depth_ms[previous], &self.point_sampler),
                 );
             }
             rec.draw_indexed(
@@ -666,7 +661,10 @@ impl Rasterizer {
         rec.end_render_pass()?;
         rec.begin_pass("depth resolve");
         rec.compute(&self.resolve)
-            .read("view_depth", (&targets.view_depth_ms, &self.point_sampler))
+            .read(
+                "view_depth",
+                (&targets.view_depth_ms[this], &self.point_sampler),
+            )
             .write("Depth", &targets.depth)
             .push(&ResolvePush {
                 width,
@@ -704,21 +702,21 @@ impl Rasterizer {
         Ok(FRAME_UNIFORM_BYTES)
     }
 
-    /// Records the prepared frame's draw, or with `peel` the next layer's (behind the depth
-    /// in `previous_depth`, which the caller wrote); returns where it leaves the layer.
+    /// Records the prepared frame's draw (`layer` 0), or the next layer's, peeled behind the
+    /// samples of the layer before, which the same submission drew; returns where it leaves
+    /// the layer.
     pub(crate) fn record_frame(
         &self,
         rec: &mut Recorder<'_>,
         state: &FrameState<'_>,
-        peel: bool,
+        layer: u32,
     ) -> crate::gpu::GpuResult<crate::render::splat::RecordedLayer<'_>> {
-        self.record(rec, state, peel)?;
+        self.record(rec, state, layer)?;
         let targets = self.targets.as_ref().expect("prepared");
         Ok(crate::render::splat::RecordedLayer {
             color: &targets.color,
             depth_m: &targets.depth,
             far_m: state.camera.far_m as f32,
-            previous_depth: &targets.previous_depth,
         })
     }
 }

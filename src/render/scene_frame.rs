@@ -1,7 +1,7 @@
 //! A scene frame recorded into splat's own submission: the rasteriser draws it there and
 //! splat's input pass reads the targets, so no pixel crosses to the host and back. A peeled
 //! frame draws every layer there too: layer 0 with the raster pipeline, each later one with
-//! the peeling pipeline reading the previous layer's depth, which the input pass wrote.
+//! the peeling pipeline reading the previous layer's samples, drawn in the same submission.
 
 use crate::gpu::{Context, GpuResult, Recorder};
 use crate::render::splat::{RecordedInput, RecordedLayer};
@@ -78,6 +78,6 @@ impl RecordedInput for SceneFrame<'_, '_> {
         rec: &mut Recorder<'_>,
         layer: u32,
     ) -> GpuResult<RecordedLayer<'a>> {
-        self.raster.record_frame(rec, self.state, layer > 0)
+        self.raster.record_frame(rec, self.state, layer)
     }
 }

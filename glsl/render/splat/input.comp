@@ -4,8 +4,8 @@
 // does to peeled layers it reads back (Rasterizer::render_layers): in a hidden layer, a pixel
 // with coverage keeps its surface's own colour (coverage divided out) and an empty one gets
 // colour 0 and depth +∞. Depth nearer than the nearest supported distance is clamped to it,
-// as host inputs are clamped. Where another layer follows, this layer's depth (the far plane
-// as +∞: it hides nothing) goes to the image the next peel reads, so it never visits the host.
+// as host inputs are clamped. The next layer's peel reads this layer's samples from the
+// rasteriser's own targets, so depth never visits the host.
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -13,13 +13,11 @@ layout(binding = 0, rgba32f) readonly uniform image2D raster_color;
 layout(std430, binding = 1) readonly buffer RasterDepth { float raster_depth_m[]; };
 layout(binding = 2, rgba32f) writeonly uniform image2D color_in;
 layout(binding = 3, r32f) writeonly uniform image2D depth_in;
-layout(binding = 4, r32f) writeonly uniform image2D previous_depth;
 
 layout(push_constant) uniform Push {
     uint width;
     uint height;
     uint layer;
-    uint write_previous;
     float near_m;
     float far_m;
 } push;
@@ -39,9 +37,6 @@ void main() {
             c = vec4(0.0);
             d = INF;
         }
-    }
-    if (push.write_previous != 0u) {
-        imageStore(previous_depth, ivec2(p), vec4(d >= push.far_m ? INF : d, 0.0, 0.0, 0.0));
     }
     if (d > 0.0 && d < push.near_m) {
         d = push.near_m;

@@ -27,8 +27,8 @@ pub trait RecordedInput {
     /// bytes it wrote for the device.
     fn prepare(&mut self) -> Result<u64>;
     /// Records the commands that make layer `layer` (0: the visible surface; layer k is
-    /// recorded after the input pass took layer k − 1, whose depth it may read from that
-    /// layer's [`RecordedLayer::previous_depth`]) and returns where they leave it.
+    /// recorded after the input pass took layer k − 1, whose samples it peels behind) and
+    /// returns where they leave it.
     fn record_layer<'a>(
         &'a self,
         rec: &mut Recorder<'_>,
@@ -45,9 +45,6 @@ pub struct RecordedLayer<'a> {
     pub depth_m: &'a Buffer,
     /// Distance at and beyond which a pixel shows no surface (the far plane, metres).
     pub far_m: f32,
-    /// An R32F storage image the next layer's draw reads this layer's depth from (the far
-    /// plane as +∞); written by the input pass only where another layer follows.
-    pub previous_depth: &'a Image,
 }
 
 pub(super) enum Source<'i, 'f> {
@@ -76,8 +73,6 @@ shader_block! {
         pub height: u32,
         /// Which layer of the stack this dispatch writes (its rows start at layer · height).
         pub layer: u32,
-        /// 1 where another layer follows and reads this one's depth.
-        pub write_previous: u32,
         pub near_m: f32,
         pub far_m: f32,
     }
@@ -196,12 +191,10 @@ impl Source<'_, '_> {
                         .read("RasterDepth", out.depth_m)
                         .write("color_in", &frame.color_in)
                         .write("depth_in", &frame.depth_in)
-                        .write("previous_depth", out.previous_depth)
                         .push(&InputPush {
                             width: frame.width,
                             height: frame.height,
                             layer,
-                            write_previous: u32::from(layer + 1 < layers),
                             near_m: crate::render::focus::nearest_supported_m(),
                             far_m: out.far_m,
                         })
