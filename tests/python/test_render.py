@@ -243,3 +243,21 @@ def test_the_merge_bound_follows_the_white_the_image_is_shown_at(renderer):
     assert np.abs(same_white / 1024 - base).max() > 1e-5 * np.abs(base).max()
     with pytest.raises(ValueError, match=r"^exposure_ev NaN must be a number of EV in \[-64, 64\]$"):
         renderer.render(eye, color, depth, exposure_ev=float("nan"), **args)
+
+
+def test_the_quality_preset_changes_the_work_and_a_bad_one_is_refused(renderer):
+    # The textured plane of the merge-bound test: `exact` merges nothing, `fast` merges blocks
+    # as wide as the blur; both stay close to each other (a fraction of the signal) and differ.
+    y, x = np.mgrid[0:H, 0:W].astype(np.float32)
+    color = np.stack([50 + 10 * np.sin(0.2 * x), 40 + 10 * np.cos(0.15 * y),
+                      30 + 10 * np.sin(0.1 * (x + y))], axis=-1).astype(np.float32)
+    depth = np.full((H, W), 0.25, np.float32)
+    eye = oc.Eye.preset("healthy")
+    args = dict(fov_y_deg=FOV, focus_m=4.0, pupil_mm=5.0, exposure_ev=-6.0)
+    with pytest.warns(UserWarning):
+        exact = renderer.render(eye, color, depth, quality="exact", **args)
+        fast = renderer.render(eye, color, depth, quality="fast", **args)
+    difference = np.abs(fast - exact).max() / np.abs(exact).max()
+    assert 0 < difference < 0.05, difference
+    with pytest.raises(ValueError, match=r'^--quality "fastest" is not one of exact, balanced, fast$'):
+        renderer.render(eye, color, depth, quality="fastest", **args)

@@ -148,7 +148,7 @@ pub enum Quality {
     #[default]
     Balanced,
     /// Merges blocks as wide as the blur from 1.5 px of blur on, wherever colours agree to an
-    /// 8-bit step shared along the rim (a 64× looser colour rule): 2.6–2.7× faster than
+    /// 8-bit step shared along the rim (a 64× looser colour rule): 2.5–2.6× faster than
     /// `balanced` at 640×360 on lavapipe, for 1.6–2.3 dB against the exact reference
     /// (docs/quality.md).
     Fast,
