@@ -129,6 +129,8 @@ struct Report {
     focus_d: f64,
     pupil_mm: f64,
     device: String,
+    /// The `--quality` preset splat ran at.
+    quality: &'static str,
     /// `reference` or `views`.
     truth: &'static str,
     /// What the ground truth shares with splat (what it cannot judge).
@@ -235,6 +237,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
             focus_d: eye_state.focus_d,
             pupil_mm: eye_state.pupil_mm,
             device: ctx.device_info().name.clone(),
+            quality: args.splat.quality.name(),
             truth: if truth.method == Method::Views {
                 "views"
             } else {
