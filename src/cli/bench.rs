@@ -385,7 +385,6 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         println!("note: {n}");
     }
     let gap_d = splat.blend.group_tolerance_d;
-    let splat_settings = splat;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = frame.input(screen.fov_y_deg);
     let runs = if args.baseline { 2 } else { 1 };
@@ -436,7 +435,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         height,
         layers,
         quality: args.splat.quality.name(),
-        settings: splat_settings,
+        settings: splat,
         warmup: args.warmup,
         frames: args.frames,
         focus_d: eye_state.focus_d,

@@ -29,15 +29,12 @@ pub(super) struct Options {
 }
 
 fn parse_quality(name: &str) -> Result<crate::render::splat::Quality> {
-    use crate::render::splat::Quality;
-    match name.trim().to_ascii_lowercase().as_str() {
-        "exact" => Ok(Quality::Exact),
-        "balanced" => Ok(Quality::Balanced),
-        "fast" => Ok(Quality::Fast),
-        _ => Err(Error::input(format!(
+    // the CLI's own parser of `--quality`, case-insensitive
+    <crate::render::splat::Quality as clap::ValueEnum>::from_str(name.trim(), true).map_err(|_| {
+        Error::input(format!(
             "--quality {name:?} is not one of exact, balanced, fast"
-        ))),
-    }
+        ))
+    })
 }
 
 fn parse_method(name: &str) -> Result<Method> {

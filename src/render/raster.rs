@@ -130,18 +130,35 @@ struct Targets {
     height: u32,
     color_ms: Image,
     depth_ms: Image,
-    /// View depth per sample, two of them: layer k is drawn into `view_depth_ms[k % 2]`, and
-    /// the peel that draws layer k + 1 reads layer k's samples from the other.
-    view_depth_ms: [Image; 2],
+    /// View depth per sample of layer 0 and every even layer.
+    view_depth_ms: Image,
     color: Image,
     framebuffer: Framebuffer,
-    /// The same targets for the peeling pipeline, one per view-depth image it draws into.
-    peel_framebuffers: [Framebuffer; 2],
+    /// What peeling adds, made at the first peel (a frame of one layer needs none).
+    peel: Option<PeelTargets>,
     /// The resolved depth (view-axis metres, row-major), on the device.
     depth: Buffer,
     /// Persistent read-back buffers (colour, depth) of the host path (`render`,
     /// `render_layers`), made at its first frame: a frame that stays on the GPU needs none.
     readback: Option<(Buffer, Buffer)>,
+}
+
+/// Layer k is drawn into the view depth of its parity (`Targets::view_depth_ms` for even k, the
+/// odd one here), and the peel that draws layer k + 1 reads layer k's samples from the other.
+struct PeelTargets {
+    odd_view_depth_ms: Image,
+    /// The peeling pipeline's targets drawing into the even and the odd view depth.
+    framebuffers: [Framebuffer; 2],
+}
+
+impl Targets {
+    /// The view depth layer `layer` is drawn into.
+    fn view_depth(&self, layer: u32) -> &Image {
+        match (&self.peel, layer % 2) {
+            (Some(peel), 1) => &peel.odd_view_depth_ms,
+            _ => &self.view_depth_ms,
+        }
+    }
 }
 
 pub struct Rasterizer {
@@ -314,18 +331,11 @@ impl Rasterizer {
             TexelFormat::Rgba32Float,
             attachment(false, false, MSAA_SAMPLES),
         )?;
-        let view_depth_ms = [
-            target(
-                "raster view depth (MSAA, even layers)",
-                TexelFormat::R32Float,
-                attachment(false, true, MSAA_SAMPLES),
-            )?,
-            target(
-                "raster view depth (MSAA, odd layers)",
-                TexelFormat::R32Float,
-                attachment(false, true, MSAA_SAMPLES),
-            )?,
-        ];
+        let view_depth_ms = target(
+            "raster view depth (MSAA)",
+            TexelFormat::R32Float,
+            attachment(false, true, MSAA_SAMPLES),
+        )?;
         let depth_ms = target(
             "raster depth buffer (MSAA)",
             TexelFormat::D32Float,
@@ -342,31 +352,61 @@ impl Rasterizer {
         )?;
         let framebuffer = self.pipeline.framebuffer(
             ctx,
-            &[&color_ms, &view_depth_ms[0]],
+            &[&color_ms, &view_depth_ms],
             &[&color],
             Some(&depth_ms),
         )?;
-        let peel_framebuffer = |k: usize| {
-            self.peel.framebuffer(
-                ctx,
-                &[&color_ms, &view_depth_ms[k]],
-                &[&color],
-                Some(&depth_ms),
-            )
-        };
-        let peel_framebuffers = [peel_framebuffer(0)?, peel_framebuffer(1)?];
         let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
             depth: Buffer::new(ctx, "raster depth", pixels * 4, Residency::Device)?,
             readback: None,
             width,
             height,
-            peel_framebuffers,
+            peel: None,
             color_ms,
             depth_ms,
             view_depth_ms,
             color,
             framebuffer,
+        });
+        Ok(())
+    }
+
+    /// The second view depth and the peeling framebuffers of this size, made once.
+    fn ensure_peel_targets(&mut self, ctx: &Context) -> Result<()> {
+        let targets = self.targets.as_mut().expect("made first");
+        if targets.peel.is_some() {
+            return Ok(());
+        }
+        let odd_view_depth_ms = Image::new_2d(
+            ctx,
+            "raster view depth (MSAA, odd layers)",
+            targets.width,
+            targets.height,
+            TexelFormat::R32Float,
+            ImageUsage {
+                sampled_linear: true,
+                storage: false,
+                color_attachment: true,
+                depth_attachment: false,
+                samples: MSAA_SAMPLES,
+            },
+        )?;
+        let framebuffer = |view_depth: &Image| {
+            self.peel.framebuffer(
+                ctx,
+                &[&targets.color_ms, view_depth],
+                &[&targets.color],
+                Some(&targets.depth_ms),
+            )
+        };
+        let framebuffers = [
+            framebuffer(&targets.view_depth_ms)?,
+            framebuffer(&odd_view_depth_ms)?,
+        ];
+        targets.peel = Some(PeelTargets {
+            odd_view_depth_ms,
+            framebuffers,
         });
         Ok(())
     }
@@ -532,6 +572,9 @@ impl Rasterizer {
         }
         self.upload_scene(ctx, state)?;
         self.ensure_targets(ctx, width, height)?;
+        if peel_gap_d.is_some() {
+            self.ensure_peel_targets(ctx)?;
+        }
         let mut uniform = FrameUniform {
             view_proj: view_proj.as_mat4().to_cols_array_2d(),
             view: state.camera.view_matrix().as_mat4().to_cols_array_2d(),
@@ -595,9 +638,9 @@ impl Rasterizer {
         let (width, height) = (targets.width, targets.height);
         let bg = state.scene.background_rgb;
         let peel = layer > 0;
-        let (this, previous) = ((layer % 2) as usize, ((layer + 1) % 2) as usize);
         let (pipeline, framebuffer, clear) = if peel {
-            (&self.peel, &targets.peel_framebuffers[this], [0.0; 4])
+            let framebuffers = &targets.peel.as_ref().expect("made by prepare").framebuffers;
+            (&self.peel, &framebuffers[(layer % 2) as usize], [0.0; 4])
         } else {
             (
                 &self.pipeline,
@@ -645,7 +688,7 @@ impl Rasterizer {
             if peel {
                 bound = bound.read(
                     "previous_samples",
-                    (&targets.view_depth_ms[previous], &self.point_sampler),
+                    (targets.view_depth(layer - 1), &self.point_sampler),
                 );
             }
             rec.draw_indexed(
@@ -663,7 +706,7 @@ impl Rasterizer {
         rec.compute(&self.resolve)
             .read(
                 "view_depth",
-                (&targets.view_depth_ms[this], &self.point_sampler),
+                (targets.view_depth(layer), &self.point_sampler),
             )
             .write("Depth", &targets.depth)
             .push(&ResolvePush {

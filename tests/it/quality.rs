@@ -5,15 +5,12 @@
 //! the cheaper presets must also do less work (kernel evaluations, counted by the engine).
 
 use crate::common;
-use crate::splat_presets::{layered, FOV_Y_DEG, H, W};
+use crate::splat_presets::{layered, paper_conditions, FOV_Y_DEG, H, W};
 
 use ocular::eye::resolve;
 use ocular::metrics::{psnr, ImageView};
-use ocular::psf::Screen;
 use ocular::render::splat::{FrameInput, Quality, SplatSettings};
-use ocular::render::{
-    dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
-};
+use ocular::render::{dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method};
 
 struct Run {
     db: f64,
@@ -35,19 +32,7 @@ fn run(
         fov_y_deg: FOV_Y_DEG,
         hidden_layers: &[],
     };
-    let state = EyeState {
-        focus_d: 1.0 / 7.5,
-        pupil_mm: 5.0,
-    };
-    let screen = Screen {
-        fov_y_deg: FOV_Y_DEG,
-        height_px: H,
-    };
-    let options = KernelOptions {
-        cache_dir: None,
-        progress: None,
-        ..KernelOptions::default()
-    };
+    let (state, screen, options) = paper_conditions();
     let eye = resolve(eye).unwrap().eye;
     let needs = scene_needs(&[dioptre_range(&depth, W, H, FOV_Y_DEG)], &[state], screen);
     let kernels = prepare_kernels(&eye, &needs, &options).unwrap();

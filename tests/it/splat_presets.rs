@@ -49,6 +49,25 @@ pub(crate) fn layered() -> (Vec<[f32; 4]>, Vec<f32>) {
     (color, depth)
 }
 
+/// The seed paper's conditions on the layered scene: the eye focused on the far plane, a 5 mm
+/// pupil, kernels computed afresh (no cache).
+pub(crate) fn paper_conditions() -> (EyeState, Screen, KernelOptions) {
+    let state = EyeState {
+        focus_d: 1.0 / 7.5,
+        pupil_mm: 5.0,
+    };
+    let screen = Screen {
+        fov_y_deg: FOV_Y_DEG,
+        height_px: H,
+    };
+    let options = KernelOptions {
+        cache_dir: None,
+        progress: None,
+        ..KernelOptions::default()
+    };
+    (state, screen, options)
+}
+
 /// Per eye, a bar about 1.5 dB under the measured value (see the printed figures). The two
 /// most blurred eyes fell when both methods began to fill the hole behind a near plane's
 /// blurred edge with the surface around it (render::blend::background_behind): myopia
@@ -76,19 +95,7 @@ fn four_preset_eyes_match_the_ground_truth() {
         fov_y_deg: FOV_Y_DEG,
         hidden_layers: &[],
     };
-    let state = EyeState {
-        focus_d: 1.0 / 7.5,
-        pupil_mm: 5.0,
-    };
-    let screen = Screen {
-        fov_y_deg: FOV_Y_DEG,
-        height_px: H,
-    };
-    let options = KernelOptions {
-        cache_dir: None,
-        progress: None,
-        ..KernelOptions::default()
-    };
+    let (state, screen, options) = paper_conditions();
     for (name, bar_db) in BARS_DB {
         let eye = resolve(name).unwrap().eye;
         let needs = scene_needs(&[dioptre_range(&depth, W, H, FOV_Y_DEG)], &[state], screen);

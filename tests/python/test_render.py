@@ -222,16 +222,21 @@ def test_default_focus_and_pupil_render_as_the_cli_does(tmp_path, cli, kernel_ca
     assert np.abs(ours - from_cli).max() <= 1e-6 * float(np.abs(from_cli).max())
 
 
+def smooth_plane():
+    """A smooth texture (cd/m²) on a plane at 0.25 m: 3.75 D out of focus when focused at 4 m."""
+    y, x = np.mgrid[0:H, 0:W].astype(np.float32)
+    color = np.stack([50 + 10 * np.sin(0.2 * x), 40 + 10 * np.cos(0.15 * y),
+                      30 + 10 * np.sin(0.1 * (x + y))], axis=-1).astype(np.float32)
+    return color, np.full((H, W), 0.25, np.float32)
+
+
 def test_the_merge_bound_follows_the_white_the_image_is_shown_at(renderer):
     # A smooth texture on a plane 3.75 D out of focus, shown with white at 64 cd/m², where the
     # colour rule lets blocks merge. The same frame ×1024 shown 10 EV darker is the
     # same picture: the merge decisions and so the image scale exactly. Kept at the first white
     # (the rule applied in the frame's own units) the bright frame merges fewer blocks and
     # renders differently.
-    y, x = np.mgrid[0:H, 0:W].astype(np.float32)
-    color = np.stack([50 + 10 * np.sin(0.2 * x), 40 + 10 * np.cos(0.15 * y),
-                      30 + 10 * np.sin(0.1 * (x + y))], axis=-1).astype(np.float32)
-    depth = np.full((H, W), 0.25, np.float32)
+    color, depth = smooth_plane()
     eye = oc.Eye.preset("healthy")
     args = dict(fov_y_deg=FOV, focus_m=4.0, pupil_mm=5.0)
     with pytest.warns(UserWarning):
@@ -248,10 +253,7 @@ def test_the_merge_bound_follows_the_white_the_image_is_shown_at(renderer):
 def test_the_quality_preset_changes_the_work_and_a_bad_one_is_refused(renderer):
     # The textured plane of the merge-bound test: `exact` merges nothing, `fast` merges blocks
     # as wide as the blur; both stay close to each other (a fraction of the signal) and differ.
-    y, x = np.mgrid[0:H, 0:W].astype(np.float32)
-    color = np.stack([50 + 10 * np.sin(0.2 * x), 40 + 10 * np.cos(0.15 * y),
-                      30 + 10 * np.sin(0.1 * (x + y))], axis=-1).astype(np.float32)
-    depth = np.full((H, W), 0.25, np.float32)
+    color, depth = smooth_plane()
     eye = oc.Eye.preset("healthy")
     args = dict(fov_y_deg=FOV, focus_m=4.0, pupil_mm=5.0, exposure_ev=-6.0)
     with pytest.warns(UserWarning):
