@@ -62,21 +62,6 @@ impl BoxIntegrator {
         let taps = cell_taps();
         // the interpolant reaches two samples beyond the outermost ones
         let w = side + 4;
-        let mut rows = vec![0.0f64; side * w];
-        for q in 0..side {
-            let src = &values[q * side..(q + 1) * side];
-            let dst = &mut rows[q * w..(q + 1) * w];
-            for (i, v) in src.iter().enumerate() {
-                let v = f64::from(*v);
-                if v == 0.0 {
-                    continue;
-                }
-                // sample i sits in padded cell i + 2 and feeds cells i .. i + 4
-                for (t, g) in taps.iter().enumerate() {
-                    dst[i + 4 - t] += v * g;
-                }
-            }
-        }
         let by_pixel = if finest.is_finite() && finest > 8.0 {
             (finest / 4.0).floor() as usize
         } else {
@@ -88,15 +73,23 @@ impl BoxIntegrator {
             .max(w.div_ceil(max_bins.max(8)));
         let m = w.div_ceil(bin);
         let mut bins = vec![0.0f64; m * m];
-        // Each row is merged into column bins once, then spread over the five rows of cells
-        // its taps reach: the vertical pass costs m per tap, not w.
+        // Row by row (one row of cells stays in cache): the row's cell integrals, merged into
+        // column bins, then spread over the five rows of cells its taps reach, so the vertical
+        // pass costs m per tap, not w.
+        let mut cells = vec![0.0f64; w];
         let mut merged = vec![0.0f64; m];
-        for q in 0..side {
-            let src = &rows[q * w..(q + 1) * w];
+        for (q, src) in values.chunks(side).take(side).enumerate() {
             if src.iter().all(|&v| v == 0.0) {
                 continue;
             }
-            for (c, chunk) in merged.iter_mut().zip(src.chunks(bin)) {
+            // sample i sits in padded cell i + 2 and feeds cells i .. i + 4
+            cells.fill(0.0);
+            for (t, g) in taps.iter().enumerate() {
+                for (d, v) in cells[4 - t..4 - t + side].iter_mut().zip(src) {
+                    *d += f64::from(*v) * g;
+                }
+            }
+            for (c, chunk) in merged.iter_mut().zip(cells.chunks(bin)) {
                 *c = chunk.iter().sum();
             }
             for (t, g) in taps.iter().enumerate() {
@@ -120,42 +113,41 @@ impl BoxIntegrator {
         self.bins.len() * 4
     }
 
-    /// Bin weights (first bin, weights) of the integral over [lo, hi] (samples from the
-    /// centre, along the binned axis): F(hi) − F(lo), F the running integral interpolated by
-    /// a cubic through the four nearest bin boundaries.
-    fn weights(&self, lo: f64, hi: f64) -> (usize, Vec<f64>) {
-        let stencil = |x: f64| -> (i64, [f64; 4]) {
-            let tau = (x - self.origin) / self.size;
-            let j0 = tau.floor() as i64 - 1;
-            let t = tau - j0 as f64; // nodes at t = 0, 1, 2, 3
-            let l = [
-                -(t - 1.0) * (t - 2.0) * (t - 3.0) / 6.0,
-                t * (t - 2.0) * (t - 3.0) / 2.0,
-                -t * (t - 1.0) * (t - 3.0) / 2.0,
-                t * (t - 1.0) * (t - 2.0) / 6.0,
-            ];
-            (j0, l)
-        };
-        let (ja, la) = stencil(lo);
-        let (jb, lb) = stencil(hi);
-        // weight of bin c: Σ over boundary nodes j > c of (lb_j − la_j)
-        let above = |j0: i64, l: &[f64; 4], c: i64| -> f64 {
-            (0..4).filter(|&k| j0 + k > c).map(|k| l[k as usize]).sum()
-        };
-        let first = ja.max(0);
-        let last = (jb + 2).min(self.m as i64 - 1);
-        if last < first {
-            return (0, Vec::new());
-        }
-        let w = (first..=last)
-            .map(|c| above(jb, &lb, c) - above(ja, &la, c))
-            .collect();
-        (first as usize, w)
-    }
-
     /// Kernel of integer `radius` whose pixels are `scale` samples wide, in screen orientation
     /// (rows reversed: screen y is down, the PSF grid's +y up), normalised to sum 1.
     pub fn kernel(&self, radius: u32, scale: f64) -> Vec<f64> {
+        self.kernel_with(&self.row_sums(), radius, scale)
+    }
+
+    /// The running sums of every bin row along x, which kernels at every radius share: build
+    /// once per PSF, then ask [`Self::kernel_with`] for each radius.
+    pub fn row_sums(&self) -> RowSums {
+        let m = self.m;
+        let mut sums = vec![0.0f64; m * (m + 1)];
+        let mut nonzero = vec![false; m];
+        for ((row, f), nz) in self
+            .bins
+            .chunks(m)
+            .zip(sums.chunks_mut(m + 1))
+            .zip(nonzero.iter_mut())
+        {
+            *nz = row.iter().any(|v| *v != 0.0);
+            if *nz {
+                let mut acc = 0.0;
+                for (v, out) in row.iter().zip(&mut f[1..]) {
+                    acc += f64::from(*v);
+                    *out = acc;
+                }
+            }
+        }
+        RowSums { sums, nonzero }
+    }
+
+    /// As [`Self::kernel`], from the integrator's [`Self::row_sums`]. A pixel's integral is
+    /// F(hi) − F(lo), F the running integral interpolated by a cubic through the four nearest
+    /// bin boundaries: read from running sums, each costs eight reads whatever the pixel's
+    /// width, first along x per bin row, then along y over the running sums of that result.
+    pub fn kernel_with(&self, row_sums: &RowSums, radius: u32, scale: f64) -> Vec<f64> {
         let side = 2 * radius as usize + 1;
         let delta = || {
             let mut v = vec![0.0; side * side];
@@ -165,38 +157,47 @@ impl BoxIntegrator {
         if radius == 0 || !(scale > 0.0 && scale.is_finite()) {
             return delta();
         }
-        let offsets: Vec<f64> = (0..side).map(|i| i as f64 - radius as f64).collect();
-        let wx: Vec<(usize, Vec<f64>)> = offsets
-            .iter()
-            .map(|u| self.weights((u - 0.5) * scale, (u + 0.5) * scale))
+        let offsets = (0..side).map(|i| i as f64 - radius as f64);
+        let sx: Vec<_> = offsets
+            .clone()
+            .map(|u| {
+                (
+                    self.stencil((u - 0.5) * scale),
+                    self.stencil((u + 0.5) * scale),
+                )
+            })
             .collect();
         // screen row offset u (down) shows PSF y = u·scale, i.e. row coordinate −u·scale
-        let wy: Vec<(usize, Vec<f64>)> = offsets
-            .iter()
-            .map(|u| self.weights(-(u + 0.5) * scale, -(u - 0.5) * scale))
+        let sy: Vec<_> = offsets
+            .map(|u| {
+                (
+                    self.stencil(-(u + 0.5) * scale),
+                    self.stencil(-(u - 0.5) * scale),
+                )
+            })
             .collect();
         let m = self.m;
-        let mut tmp = vec![0.0f64; m * side];
-        for (r, row) in self.bins.chunks(m).enumerate() {
-            if row.iter().all(|v| *v == 0.0) {
-                continue;
+        // running sums over bin rows of the x-integrated rows: G[r] = Σ_{q<r} tmp[q]
+        let mut g = vec![0.0f64; (m + 1) * side];
+        let mut acc = vec![0.0f64; side];
+        for (r, f) in row_sums.sums.chunks(m + 1).enumerate() {
+            if row_sums.nonzero[r] {
+                for (a, (lo, hi)) in acc.iter_mut().zip(&sx) {
+                    *a += between(f, lo, hi);
+                }
             }
-            let out = &mut tmp[r * side..(r + 1) * side];
-            for (o, (start, w)) in out.iter_mut().zip(&wx) {
-                *o = w
-                    .iter()
-                    .zip(&row[*start..])
-                    .map(|(a, b)| a * f64::from(*b))
-                    .sum();
-            }
+            g[(r + 1) * side..(r + 2) * side].copy_from_slice(&acc);
         }
         let mut out = vec![0.0f64; side * side];
-        for (j, (start, w)) in wy.iter().enumerate() {
-            let dst = &mut out[j * side..(j + 1) * side];
-            for (t, wq) in w.iter().enumerate() {
-                let src = &tmp[(start + t) * side..(start + t + 1) * side];
-                for (o, s) in dst.iter_mut().zip(src) {
-                    *o += wq * s;
+        let at = |j: i64| j.clamp(0, m as i64) as usize * side;
+        for (dst, ((ja, la), (jb, lb))) in out.chunks_mut(side).zip(&sy) {
+            for k in 0..4 {
+                let (hi, lo) = (at(jb + k as i64), at(ja + k as i64));
+                for (o, (gh, gl)) in dst
+                    .iter_mut()
+                    .zip(g[hi..hi + side].iter().zip(&g[lo..lo + side]))
+                {
+                    *o += lb[k] * gh - la[k] * gl;
                 }
             }
         }
@@ -210,6 +211,37 @@ impl BoxIntegrator {
             delta()
         }
     }
+
+    /// The first of the four bin boundaries around `x` (samples from the centre, along a
+    /// binned axis) and the cubic Lagrange weights of F at them.
+    fn stencil(&self, x: f64) -> (i64, [f64; 4]) {
+        let tau = (x - self.origin) / self.size;
+        let j0 = tau.floor() as i64 - 1;
+        let t = tau - j0 as f64; // nodes at t = 0, 1, 2, 3
+        let l = [
+            -(t - 1.0) * (t - 2.0) * (t - 3.0) / 6.0,
+            t * (t - 2.0) * (t - 3.0) / 2.0,
+            -t * (t - 1.0) * (t - 3.0) / 2.0,
+            t * (t - 1.0) * (t - 2.0) / 6.0,
+        ];
+        (j0, l)
+    }
+}
+
+/// Running sums of an integrator's bin rows along x (row r: F_r(0) = 0 … F_r(m) = the row's
+/// total), and which rows hold anything.
+pub struct RowSums {
+    sums: Vec<f64>,
+    nonzero: Vec<bool>,
+}
+
+/// F(hi) − F(lo) for a running sum `f` (constant beyond its ends) and two stencils.
+fn between(f: &[f64], (ja, la): &(i64, [f64; 4]), (jb, lb): &(i64, [f64; 4])) -> f64 {
+    let last = f.len() as i64 - 1;
+    let at = |j: i64| f[j.clamp(0, last) as usize];
+    (0..4)
+        .map(|k| lb[k] * at(jb + k as i64) - la[k] * at(ja + k as i64))
+        .sum()
 }
 
 #[cfg(test)]

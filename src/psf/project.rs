@@ -238,9 +238,14 @@ pub fn crop(
     let c = side / 2;
     let mut rings = vec![0.0f64; c + 1];
     for (q, row) in intensity.chunks(side).enumerate() {
+        // Samples within dy of the centre column fall in ring dy; those beyond, in ring |i − c|
+        // (the same ring from either side): contiguous runs, so the loops vectorise.
         let dy = q.abs_diff(c);
-        for (i, v) in row.iter().enumerate() {
-            rings[dy.max(i.abs_diff(c))] += v.max(0.0);
+        rings[dy] += row[c - dy..=c + dy].iter().map(|v| v.max(0.0)).sum::<f64>();
+        let outer = &mut rings[dy + 1..];
+        let (left, right) = (&row[..c - dy], &row[c + dy + 1..]);
+        for ((ring, l), r) in outer.iter_mut().zip(left.iter().rev()).zip(right) {
+            *ring += l.max(0.0) + r.max(0.0);
         }
     }
     let total: f64 = rings.iter().sum();
