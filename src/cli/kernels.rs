@@ -53,6 +53,11 @@ pub struct KernelsArgs {
     /// Fraction of each PSF's energy the cropped kernel keeps.
     #[arg(long, default_value_t = 0.999)]
     pub energy: f64,
+    /// Object samples get a PSF of their own only where the blend of the computed ones
+    /// around them would misplace more than this fraction of a kernel's energy (L1, 0 to 0.5;
+    /// 0 computes every sample). Dense near each colour's focus, sparse far from it.
+    #[arg(long, value_name = "L1", default_value_t = crate::psf::DEFAULT_OBJECT_TOLERANCE)]
+    pub object_tolerance: f64,
     /// Only what a scene needs: its depth range in dioptres (MIN..MAX); with one --focus-d and
     /// one --pupils-mm value this is a single column of the grid.
     #[arg(long, value_name = "MIN..MAX")]
@@ -158,6 +163,8 @@ impl Bars {
             );
             bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         }
+        // The PSF total grows round by round as intervals are split (psf::object_knots).
+        bar.set_length(total as u64);
         bar.set_position(done as u64);
     }
 
@@ -327,7 +334,13 @@ fn planned_grid(args: &KernelsArgs) -> Result<Planned> {
         fov_y_deg: args.fov_y,
         height_px: args.height,
     };
-    let settings = grid_settings(&axes, &screen, args.rmax_cap, args.energy)?;
+    let settings = grid_settings(
+        &axes,
+        &screen,
+        args.rmax_cap,
+        args.energy,
+        args.object_tolerance,
+    )?;
     let (mut skipped, mut notes) = (0, Vec::new());
     if let Some(range) = &args.scene_d {
         let narrowed = scene_grid(&axes, screen, parse_range("scene-d", range)?)?;
@@ -394,7 +407,7 @@ fn print_summary(summary: &Summary<'_>, grid: &crate::psf::kernels::KernelGrid) 
     };
     println!(
         "{}: {} sets (pupils {:?} mm × focus {:?} D), {} objects {:.3}..{:.3} D, Rmax {} px, \
-         {:.1} MiB per set; {} PSFs ({} skipped), {source}",
+         {:.1} MiB per set; {} PSFs ({} skipped{}), {source}",
         summary.output,
         summary.sets,
         grid.pupils_mm,
@@ -406,6 +419,10 @@ fn print_summary(summary: &Summary<'_>, grid: &crate::psf::kernels::KernelGrid) 
         summary.bytes_per_set as f64 / (1 << 20) as f64,
         summary.psfs,
         summary.psfs_skipped,
+        summary.report.map_or(String::new(), |r| format!(
+            ", {} computed, {} blended between them",
+            r.psfs_computed, r.psfs_filled
+        )),
     );
     for n in summary.plan_notes {
         println!("  plan: {n}");

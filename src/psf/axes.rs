@@ -200,6 +200,17 @@ pub struct KernelSettings {
     pub max_beta_degree: u32,
     /// Relative accuracy of the ENZ radial tables.
     pub radial_tolerance: f64,
+    /// Largest L1 distance (fraction of a kernel's energy misplaced) between a kernel and the
+    /// one interpolated from the computed object samples around it: PSFs are computed where
+    /// the object axis needs them (dense near each channel's focus, sparse far from it) and
+    /// the samples between are filled by the runtime's own linear blend
+    /// ([`super::object_knots`]). 0 computes every sample.
+    #[serde(default = "default_object_tolerance")]
+    pub object_tolerance: f64,
+}
+
+fn default_object_tolerance() -> f64 {
+    super::object_knots::DEFAULT_OBJECT_TOLERANCE
 }
 
 impl Default for KernelSettings {
@@ -220,13 +231,14 @@ impl Default for KernelSettings {
             beta_tolerance: 1e-4,
             max_beta_degree: 120,
             radial_tolerance: 1e-5,
+            object_tolerance: default_object_tolerance(),
         }
     }
 }
 
 impl KernelSettings {
     pub fn validate(&self) -> Result<(), String> {
-        let checks: [(&str, f64, f64, f64); 11] = [
+        let checks: [(&str, f64, f64, f64); 12] = [
             ("sample_um", self.sample_um, 0.05, 100.0),
             ("um_per_deg", self.um_per_deg, 100.0, 500.0),
             ("samples_per_2pi", self.samples_per_2pi, 1.0, 64.0),
@@ -243,6 +255,7 @@ impl KernelSettings {
             ("beta_tolerance", self.beta_tolerance, 1e-12, 0.1),
             ("radial_tolerance", self.radial_tolerance, 1e-12, 1e-2),
             ("max_radius_cap", self.max_radius_cap as f64, 0.0, 512.0),
+            ("object_tolerance", self.object_tolerance, 0.0, 0.5),
         ];
         for (name, v, lo, hi) in checks {
             if !(v.is_finite() && v >= lo && v <= hi) {

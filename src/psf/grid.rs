@@ -11,8 +11,10 @@ use super::defocus::ColumnOptics;
 use super::field_psf::cropped_psf;
 use super::integrate::BoxIntegrator;
 use super::kernels::{
-    kernel_side, level_block_radius, level_count, level_radius_px, KernelGrid, KernelSet,
+    kernel_side, level_block_radius, level_count, level_radius_px, texels_below_level, KernelGrid,
+    KernelSet,
 };
+use super::object_knots::{brackets, initial_knots, midpoint, open_intervals, weight};
 use super::project::{PsfMethod, MAX_BINS};
 use crate::eye::Eye;
 use crate::{Error, Result};
@@ -56,6 +58,9 @@ pub struct ColumnReport {
     pub missed_energy: [f64; 3],
     /// PSFs of the column computed by FFT, per channel (the rest by the ENZ series).
     pub fft_psfs: [usize; 3],
+    /// PSFs computed per channel: the object knots ([`super::object_knots`]); the other
+    /// samples are blends of them.
+    pub psfs: [usize; 3],
 }
 
 /// Largest pupil energy a kernel's PSF may miss; beyond it the report carries a warning.
@@ -65,6 +70,8 @@ pub const MISSED_ENERGY_LIMIT: f64 = 1e-3;
 #[derive(Clone, Debug, Serialize)]
 pub struct GridReport {
     pub psfs_computed: usize,
+    /// Object samples filled by the blend of the computed ones around them.
+    pub psfs_filled: usize,
     /// PSFs of a reference grid that were not needed (see [`super::plan`]); 0 otherwise.
     pub psfs_skipped: usize,
     pub max_radius_px: u32,
@@ -157,23 +164,32 @@ pub fn kernels_from_columns(
 
 /// The PSFs of a grid's columns, kept as their pixel-integration bins: what the kernels are
 /// made from at any largest radius (grids that share one texture share their largest radius,
-/// so it is chosen only once every PSF is known).
+/// so it is chosen only once every PSF is known). Indexed (column·3 + channel)·objects +
+/// object; `None` where the object sample is filled from the knots around it
+/// ([`super::object_knots`]).
 pub(crate) struct ColumnPsfs {
-    psfs: Vec<PsfSummary>,
+    psfs: Vec<Option<PsfSummary>>,
     seconds: f64,
 }
 
 impl ColumnPsfs {
-    /// Largest natural PSF radius over every PSF (px, before any cap).
+    /// Largest natural PSF radius over every PSF (px, before any cap). Filled samples lie
+    /// between their knots' radii.
     pub fn natural_max_radius_px(&self) -> f64 {
-        self.psfs
-            .iter()
+        self.computed()
             .map(|p| p.natural_radius_px)
             .fold(0.0f64, f64::max)
     }
+
+    fn computed(&self) -> impl Iterator<Item = &PsfSummary> + Clone {
+        self.psfs.iter().flatten()
+    }
 }
 
-/// Every PSF of `columns` (per column, channel and object distance).
+/// Every PSF `columns` need (per column, channel and object knot): the knots start a dioptre
+/// apart and intervals are halved, all columns and channels together round by round, while
+/// the kernel at an interval's midpoint differs from the blend of its ends by more than
+/// `settings.object_tolerance`.
 pub(crate) fn psfs_of_columns(
     columns: &[ColumnOptics],
     axes: &GridAxes,
@@ -189,37 +205,103 @@ pub(crate) fn psfs_of_columns(
         ));
     }
     let no = axes.objects.count;
+    let series = columns.len() * 3;
     let t1 = Instant::now();
-    // PSFs set by set, each kept only as its pixel-integration bins (a set's full-resolution
-    // PSFs would not fit in memory for a whole grid); the largest radius is known at the end.
+    let compute = |s: usize, o: usize| -> Result<PsfSummary> {
+        let ch = &columns[s / 3].channels[s % 3];
+        let p = cropped_psf(ch, axes.objects.value_d(o), screen, settings)?;
+        Ok(PsfSummary {
+            natural_radius_px: p.natural_radius_px(),
+            natural_half_samples: p.natural_half_samples,
+            kept_energy: p.kept_energy,
+            grid_side: p.grid_side,
+            method: p.method,
+            missed_energy: p.missed_energy,
+            bins: p.integrator(settings.max_radius_cap, MAX_BINS),
+        })
+    };
+    // Each PSF is kept only as its pixel-integration bins (a set's full-resolution PSFs would
+    // not fit in memory for a whole grid); the largest radius is known at the end.
+    let mut psfs: Vec<Option<PsfSummary>> = (0..series * no).map(|_| None).collect();
+    let first = initial_knots(no, axes.objects.step_d, settings.object_tolerance);
+    let mut jobs: Vec<(usize, usize)> = (0..series)
+        .flat_map(|s| first.iter().map(move |&o| (s, o)))
+        .collect();
+    let mut intervals: Vec<(usize, (usize, usize))> = (0..series)
+        .flat_map(|s| open_intervals(&first).into_iter().map(move |i| (s, i)))
+        .collect();
     let done = AtomicUsize::new(0);
-    let total = columns.len() * 3 * no;
-    let mut psfs: Vec<PsfSummary> = Vec::with_capacity(total);
-    for col in columns {
-        let jobs: Vec<(usize, usize)> = (0..3).flat_map(|c| (0..no).map(move |o| (c, o))).collect();
+    loop {
+        // The total grows round by round: what is known so far.
+        let total = done.load(Ordering::Relaxed) + jobs.len();
         let part: Vec<PsfSummary> = jobs
             .par_iter()
-            .map(|&(c, o)| {
-                let p = cropped_psf(&col.channels[c], axes.objects.value_d(o), screen, settings)?;
-                let summary = PsfSummary {
-                    natural_radius_px: p.natural_radius_px(),
-                    natural_half_samples: p.natural_half_samples,
-                    kept_energy: p.kept_energy,
-                    grid_side: p.grid_side,
-                    method: p.method,
-                    missed_energy: p.missed_energy,
-                    bins: p.integrator(settings.max_radius_cap, MAX_BINS),
-                };
+            .map(|&(s, o)| {
+                let summary = compute(s, o)?;
                 progress(Stage::Psfs, done.fetch_add(1, Ordering::Relaxed) + 1, total);
                 Ok(summary)
             })
             .collect::<Result<_>>()?;
-        psfs.extend(part);
+        for (&(s, o), p) in jobs.iter().zip(part) {
+            psfs[s * no + o] = Some(p);
+        }
+        // The midpoints just computed judge their intervals.
+        let split: Vec<bool> = intervals
+            .par_iter()
+            .map(|&(s, (a, b))| {
+                let m = midpoint((a, b));
+                let at = |o: usize| psfs[s * no + o].as_ref();
+                match (at(a), at(m), at(b)) {
+                    (Some(pa), Some(pm), Some(pb)) => {
+                        blend_error(pa, pm, pb, weight(a, m, b), settings.max_radius_cap)
+                            > settings.object_tolerance
+                    }
+                    _ => false,
+                }
+            })
+            .collect();
+        let mut next = Vec::new();
+        for (&(s, (a, b)), split) in intervals.iter().zip(split) {
+            let m = midpoint((a, b));
+            if psfs[s * no + m].is_none() {
+                // first visit: compute the midpoint, judge next round
+                next.push((s, (a, b)));
+            } else if split {
+                next.extend(open_intervals(&[a, m, b]).into_iter().map(|i| (s, i)));
+            }
+        }
+        intervals = next;
+        jobs = intervals
+            .iter()
+            .map(|&(s, i)| (s, midpoint(i)))
+            .filter(|&(s, o)| psfs[s * no + o].is_none())
+            .collect();
+        jobs.sort_unstable();
+        jobs.dedup();
+        if jobs.is_empty() {
+            break;
+        }
     }
     Ok(ColumnPsfs {
         psfs,
         seconds: t1.elapsed().as_secs_f64(),
     })
+}
+
+/// L1 distance between the kernel of `m` and the runtime's blend of `a` and `b` (weight `t`
+/// on `b`) drawn where the runtime would draw it: at the radius blended the same way. Both
+/// on one block, each at its own natural radius as the grid stores it.
+fn blend_error(a: &PsfSummary, m: &PsfSummary, b: &PsfSummary, t: f64, cap: u32) -> f64 {
+    let radius = |p: &PsfSummary| p.natural_radius_px.min(f64::from(cap));
+    let (r_m, r_blend) = (radius(m), (1.0 - t) * radius(a) + t * radius(b));
+    let block = r_m.max(r_blend).ceil().max(1.0) as u32;
+    let drawn = |p: &PsfSummary, r: f64| p.bins.kernel(block, p.natural_half_samples / (r + 0.5));
+    let (truth, ka, kb) = (drawn(m, r_m), drawn(a, r_blend), drawn(b, r_blend));
+    truth
+        .iter()
+        .zip(ka.iter().zip(&kb))
+        .map(|(x, (p, q))| (x - ((1.0 - t) * p + t * q)).abs())
+        .sum()
 }
 
 /// The grid of `columns` from their PSFs, with kernels up to `radius_px` (at least every
@@ -242,12 +324,12 @@ pub(crate) fn grid_from_psfs(
             "one PSF per column, channel and object is required",
         ));
     }
-    let psf = |s: usize, c: usize, o: usize| &psfs[(s * 3 + c) * no + o];
+    let psf = |s: usize, c: usize, o: usize| psfs[(s * 3 + c) * no + o].as_ref();
     let max_radius = radius_px
         .max(natural_max.ceil() as u32)
         .min(settings.max_radius_cap);
-    let clamped_radii = psfs
-        .iter()
+    let computed = || psfs.iter().flatten();
+    let clamped_radii = computed()
         .filter(|p| p.natural_radius_px > max_radius as f64)
         .count();
 
@@ -257,40 +339,78 @@ pub(crate) fn grid_from_psfs(
     let mut sets = Vec::with_capacity(columns.len());
     for (s, col) in columns.iter().enumerate() {
         let mut set = KernelSet::zeroed(col.pupil_mm, col.focus_d, axes.objects, max_radius);
-        for o in 0..no {
-            for c in 0..3 {
-                set.radius_px[o][c] = psf(s, c, o).natural_radius_px.min(max_radius as f64) as f32;
+        // Per channel, the knots around every object sample (a knot is its own).
+        let around: [Vec<(usize, usize, f64)>; 3] =
+            std::array::from_fn(|c| brackets(no, |o| psf(s, c, o).is_some()));
+        for (c, around) in around.iter().enumerate() {
+            let r = |k: usize| psf(s, c, k).map_or(0.0, |p| p.natural_radius_px);
+            for (radii, &(a, b, t)) in set.radius_px.iter_mut().zip(around) {
+                radii[c] = ((1.0 - t) * r(a) + t * r(b)).min(max_radius as f64) as f32;
             }
         }
-        // Blocks are laid out level-major: split the texels into one slice per (level, o).
+        // Blocks are laid out level-major (level, then object). First the knots' blocks from
+        // their PSFs, in parallel over objects, each PSF's running sums shared by its levels.
         let levels = level_count(max_radius);
-        let mut blocks: Vec<(u32, usize, &mut [[f32; 3]])> = Vec::new();
+        let mut per_object: Vec<Vec<LevelBlock>> = (0..no).map(|_| Vec::new()).collect();
         let mut rest: &mut [[f32; 3]] = &mut set.texels;
         for level in 0..levels {
             let n = kernel_side(level_block_radius(level)).pow(2);
-            for o in 0..no {
+            for blocks in per_object.iter_mut() {
                 let (head, tail) = rest.split_at_mut(n);
-                blocks.push((level, o, head));
+                blocks.push((level, head));
                 rest = tail;
             }
         }
-        // Group by object so progress counts (set, object) units; levels run in parallel.
-        blocks.par_iter_mut().for_each(|(level, o, block)| {
-            let (radius, support) = (level_block_radius(*level), level_radius_px(*level) + 0.5);
-            for c in 0..3 {
-                let p = psf(s, c, *o);
-                // the natural half-width spans `support` px: pixels of half_samples / support
-                let k = p.bins.kernel(radius, p.natural_half_samples / support);
-                for (t, v) in block.iter_mut().zip(&k) {
-                    t[c] = *v as f32;
+        per_object
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(o, blocks)| {
+                for c in 0..3 {
+                    let Some(p) = psf(s, c, o) else { continue };
+                    let sums = p.bins.row_sums();
+                    for (level, block) in blocks.iter_mut() {
+                        let radius = level_block_radius(*level);
+                        // the natural half-width spans r + ½ px: pixels of half_samples / (r + ½)
+                        let scale = p.natural_half_samples / (level_radius_px(*level) + 0.5);
+                        let k = p.bins.kernel_with(&sums, radius, scale);
+                        for (t, v) in block.iter_mut().zip(&k) {
+                            t[c] = *v as f32;
+                        }
+                    }
                 }
-            }
-            if *level == levels - 1 {
                 progress(
                     Stage::Kernels,
                     done.fetch_add(1, Ordering::Relaxed) + 1,
                     total_blocks,
                 );
+            });
+        drop(per_object);
+        // Then the samples between knots: the runtime's blend of their knots' blocks.
+        let mut per_level: Vec<(u32, &mut [[f32; 3]])> = Vec::new();
+        let mut rest: &mut [[f32; 3]] = &mut set.texels;
+        for level in 0..levels {
+            let n = kernel_side(level_block_radius(level)).pow(2);
+            let (head, tail) = rest.split_at_mut(n * no);
+            per_level.push((level, head));
+            rest = tail;
+        }
+        debug_assert_eq!(
+            per_level.iter().map(|(_, l)| l.len()).sum::<usize>(),
+            no * texels_below_level(levels)
+        );
+        per_level.par_iter_mut().for_each(|(level, texels)| {
+            let n = kernel_side(level_block_radius(*level)).pow(2);
+            for (c, around) in around.iter().enumerate() {
+                for (o, &(a, b, t)) in around.iter().enumerate() {
+                    if a == o {
+                        continue;
+                    }
+                    let t = t as f32;
+                    for i in 0..n {
+                        let blend = (1.0 - t) * texels[a * n + i][c] + t * texels[b * n + i][c];
+                        texels[o * n + i][c] = blend;
+                    }
+                }
             }
         });
         sets.push(set);
@@ -314,9 +434,10 @@ pub(crate) fn grid_from_psfs(
         .map(|(s, c)| {
             let mut r = column_report(c);
             for ch in 0..3 {
-                let these = (0..no).map(|o| psf(s, ch, o));
+                let these = (0..no).filter_map(|o| psf(s, ch, o));
                 r.missed_energy[ch] = these.clone().map(|p| p.missed_energy).fold(0.0, f64::max);
-                r.fft_psfs[ch] = these.filter(|p| p.method == PsfMethod::Fft).count();
+                r.fft_psfs[ch] = these.clone().filter(|p| p.method == PsfMethod::Fft).count();
+                r.psfs[ch] = these.count();
             }
             r
         })
@@ -333,17 +454,19 @@ pub(crate) fn grid_from_psfs(
             }
         }
     }
+    let psfs_computed = computed().count();
     let report = GridReport {
-        psfs_computed: psfs.len(),
+        psfs_computed,
+        psfs_filled: psfs.len() - psfs_computed,
         psfs_skipped: 0,
         max_radius_px: max_radius,
         natural_max_radius_px: natural_max,
         clamped_radii,
-        min_kept_energy: psfs.iter().map(|p| p.kept_energy).fold(1.0, f64::min),
-        largest_psf_side: psfs.iter().map(|p| p.grid_side).max().unwrap_or(0),
+        min_kept_energy: computed().map(|p| p.kept_energy).fold(1.0, f64::min),
+        largest_psf_side: computed().map(|p| p.grid_side).max().unwrap_or(0),
         bytes_per_set: grid.sets.first().map_or(0, KernelSet::size_bytes),
-        psfs_fft: psfs.iter().filter(|p| p.method == PsfMethod::Fft).count(),
-        worst_missed_energy: psfs.iter().map(|p| p.missed_energy).fold(0.0, f64::max),
+        psfs_fft: computed().filter(|p| p.method == PsfMethod::Fft).count(),
+        worst_missed_energy: computed().map(|p| p.missed_energy).fold(0.0, f64::max),
         missed_energy_limit: MISSED_ENERGY_LIMIT,
         warnings,
         seconds_optics: 0.0,
@@ -353,6 +476,9 @@ pub(crate) fn grid_from_psfs(
     };
     Ok((grid, report))
 }
+
+/// One radius level's block of one object's kernel (texels RGB).
+type LevelBlock<'a> = (u32, &'a mut [[f32; 3]]);
 
 /// What the kernel stage keeps of one PSF.
 struct PsfSummary {
@@ -383,5 +509,6 @@ fn column_report(c: &ColumnOptics) -> ColumnReport {
             .map(|ch| ch.pupil.beta.truncation_error),
         missed_energy: [0.0; 3],
         fft_psfs: [0; 3],
+        psfs: [0; 3],
     }
 }

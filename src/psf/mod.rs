@@ -4,7 +4,8 @@
 //! - [`defocus`]: one (pupil, focus) state of an eye and the defocus of every object distance.
 //! - [`project`]: PSF sampling (ENZ or FFT per PSF), energy crop, screen orientation.
 //! - [`integrate`]: the PSF integrated over screen pixels of any size.
-//! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs.
+//! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs;
+//!   [`object_knots`]: which object samples get a PSF of their own.
 //! - [`exact`]: exact kernels at any vergence for the ground truth.
 //! - [`field_shape`]: a field direction's elliptical pupil; [`field_psf`]: a channel's PSF
 //!   anywhere in the field (the on-axis one, or the disc's resampled onto the ellipse);
@@ -28,6 +29,7 @@ pub(crate) mod field_shape;
 pub(crate) mod grid;
 pub(crate) mod integrate;
 pub(crate) mod kernels;
+pub(crate) mod object_knots;
 pub(crate) mod plan;
 pub(crate) mod preview;
 pub(crate) mod project;
@@ -47,6 +49,7 @@ pub use kernels::{
     kernel_side, level_block_radius, level_count, level_of_radius, level_radius_px, DioptreAxis,
     KernelGrid, KernelSet,
 };
+pub use object_knots::DEFAULT_OBJECT_TOLERANCE;
 pub use plan::{objects_for_screen, plan_for_scene, SceneNeeds, OBJECT_STEP_BLUR_PX};
 // Kernels across the visual field.
 pub use field::{field_column, frame_half_field_deg, FieldAxes};

@@ -6,12 +6,14 @@ use crate::psf::plan::{plan_for_scene, SceneNeeds};
 use crate::{Error, Result};
 
 /// The kernel settings of a grid of `axes` for `screen`, with its largest radius (px) and the
-/// fraction of each PSF's energy a kernel keeps; the axes, screen and settings are checked.
+/// fraction of each PSF's energy a kernel keeps and the object axis' blend tolerance; the axes,
+/// screen and settings are checked.
 pub fn grid_settings(
     axes: &GridAxes,
     screen: &Screen,
     rmax_cap: u32,
     energy: f64,
+    object_tolerance: f64,
 ) -> Result<KernelSettings> {
     axes.validate()
         .map_err(|e| Error::input(format!("--{e}")))?;
@@ -21,11 +23,13 @@ pub fn grid_settings(
     let settings = KernelSettings {
         max_radius_cap: rmax_cap,
         energy,
+        object_tolerance,
         ..KernelSettings::default()
     };
     settings.validate().map_err(|e| {
         Error::input(
             e.replace("max_radius_cap", "--rmax-cap")
+                .replace("object_tolerance", "--object-tolerance")
                 .replace("energy", "--energy"),
         )
     })?;

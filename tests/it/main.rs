@@ -37,6 +37,7 @@ mod layers;
 mod metrics;
 mod metrics_small;
 mod object_axis;
+mod object_knots;
 mod off_axis_kernels;
 mod off_axis_optics;
 mod off_axis_runtime;
