@@ -74,6 +74,8 @@ struct FrameReport {
     method: Method,
     seconds: f64,
     kernels_reused: bool,
+    /// Planning, loading or computing the kernels of a new eye state (0 when reused).
+    seconds_kernels: f64,
     accommodation_max_d: Option<f64>,
     warnings: Vec<String>,
 }
@@ -129,6 +131,7 @@ impl PyRenderer {
             .as_ref()
             .is_some_and(|p| p.key == key && p.axes == planned.axes);
         let mut warnings = Vec::new();
+        let kernels_started = std::time::Instant::now();
         if !reusable {
             inner.prepared = None;
             // Fails, with the options named, where the eye cannot focus at all.
@@ -152,6 +155,11 @@ impl PyRenderer {
                 renderer,
             });
         }
+        let seconds_kernels = if reusable {
+            0.0
+        } else {
+            kernels_started.elapsed().as_secs_f64()
+        };
         let Inner {
             prepared,
             rasterizer,
@@ -189,6 +197,7 @@ impl PyRenderer {
             method: o.method,
             seconds: rendered.seconds,
             kernels_reused: reusable,
+            seconds_kernels,
             accommodation_max_d: physiology.accommodation_max_d,
             warnings,
         });
@@ -475,6 +484,7 @@ impl PyRenderer {
         d.set_item("pupil_from", &r.pupil_from)?;
         d.set_item("method", r.method.name())?;
         d.set_item("seconds", r.seconds)?;
+        d.set_item("seconds_kernels", r.seconds_kernels)?;
         d.set_item("kernels_reused", r.kernels_reused)?;
         d.set_item("accommodation_max_d", r.accommodation_max_d)?;
         Ok(Some(d))

@@ -66,11 +66,13 @@ def test_frames_reuse_the_kernels_while_the_eye_state_holds(kernel_cache):
     second = r.render(eye, shifted, depth, fov_y_deg=FOV, focus_m=1.0, pupil_mm=3.0)
     assert r.stats == {"frames": 2, "kernel_preparations": 1}
     assert r.last_frame["kernels_reused"] is True
+    assert r.last_frame["seconds_kernels"] == 0.0
     assert not np.array_equal(first, second)
-    # a new pupil is a new eye state
+    # a new pupil is a new eye state, whose kernels take time
     r.render(eye, color, depth, fov_y_deg=FOV, focus_m=1.0, pupil_mm=4.0)
     assert r.stats["kernel_preparations"] == 2
     assert r.last_frame["pupil_mm"] == 4.0 and r.last_frame["kernels_reused"] is False
+    assert r.last_frame["seconds_kernels"] > 0.0
 
 
 def test_default_focus_and_pupil_follow_the_cli(renderer):
