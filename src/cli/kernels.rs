@@ -56,7 +56,12 @@ pub struct KernelsArgs {
     /// Object samples get a PSF of their own only where the blend of the computed ones
     /// around them would misplace more than this fraction of a kernel's energy (L1, 0 to 0.5;
     /// 0 computes every sample). Dense near each colour's focus, sparse far from it.
-    #[arg(long, value_name = "L1", default_value_t = crate::psf::DEFAULT_OBJECT_TOLERANCE)]
+    #[arg(
+        long,
+        value_name = "L1",
+        allow_hyphen_values = true,
+        default_value_t = crate::psf::DEFAULT_OBJECT_TOLERANCE
+    )]
     pub object_tolerance: f64,
     /// Only what a scene needs: its depth range in dioptres (MIN..MAX); with one --focus-d and
     /// one --pupils-mm value this is a single column of the grid.

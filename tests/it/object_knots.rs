@@ -94,24 +94,26 @@ fn blended_samples_stay_within_the_tolerance_of_their_own_kernels() {
 }
 
 #[test]
-fn kernels_reports_and_checks_the_tolerance() {
+fn kernels_checks_the_tolerance() {
     let bin = env!("CARGO_BIN_EXE_ocular");
-    let out = std::process::Command::new(bin)
-        .args([
-            "kernels",
-            "--eye",
-            "healthy",
-            "--object-tolerance",
-            "0.9",
-            "-o",
-        ])
-        .arg(std::env::temp_dir().join("ocular-object-knots-bad.bin"))
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        err.contains("--object-tolerance") && err.lines().count() == 1,
-        "{err}"
-    );
+    for bad in ["0.9", "-1", "nan"] {
+        let out = std::process::Command::new(bin)
+            .args([
+                "kernels",
+                "--eye",
+                "healthy",
+                "--object-tolerance",
+                bad,
+                "-o",
+            ])
+            .arg(std::env::temp_dir().join("ocular-object-knots-bad.bin"))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("--object-tolerance") && err.lines().count() == 1,
+            "{bad}: {err}"
+        );
+    }
 }
