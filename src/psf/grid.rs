@@ -276,8 +276,6 @@ pub(crate) fn psfs_of_columns(
             .map(|&(s, i)| (s, midpoint(i)))
             .filter(|&(s, o)| psfs[s * no + o].is_none())
             .collect();
-        jobs.sort_unstable();
-        jobs.dedup();
         if jobs.is_empty() {
             break;
         }

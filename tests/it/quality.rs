@@ -5,11 +5,11 @@
 //! the cheaper presets must also do less work (kernel evaluations, counted by the engine).
 
 use crate::common;
-use crate::splat_presets::{layered, paper_conditions, FOV_Y_DEG, H, W};
+use crate::splat_presets::{layered, layered_input, paper_conditions, FOV_Y_DEG, H, W};
 
 use ocular::eye::resolve;
 use ocular::metrics::{psnr, ImageView};
-use ocular::render::splat::{FrameInput, Quality, SplatSettings};
+use ocular::render::splat::{Quality, SplatSettings};
 use ocular::render::{dioptre_range, prepare_kernels, scene_needs, FrameRenderer, Method};
 
 struct Run {
@@ -24,14 +24,7 @@ fn run(
     truth: &mut Option<Vec<[f32; 4]>>,
 ) -> Run {
     let (color, depth) = layered();
-    let input = FrameInput {
-        width: W,
-        height: H,
-        color: &color,
-        depth_m: &depth,
-        fov_y_deg: FOV_Y_DEG,
-        hidden_layers: &[],
-    };
+    let input = layered_input(&color, &depth);
     let (state, screen, options) = paper_conditions();
     let eye = resolve(eye).unwrap().eye;
     let needs = scene_needs(&[dioptre_range(&depth, W, H, FOV_Y_DEG)], &[state], screen);

@@ -49,6 +49,18 @@ pub(crate) fn layered() -> (Vec<[f32; 4]>, Vec<f32>) {
     (color, depth)
 }
 
+/// The layered scene as one frame's input (no hidden layers).
+pub(crate) fn layered_input<'a>(color: &'a [[f32; 4]], depth: &'a [f32]) -> FrameInput<'a> {
+    FrameInput {
+        width: W,
+        height: H,
+        color,
+        depth_m: depth,
+        fov_y_deg: FOV_Y_DEG,
+        hidden_layers: &[],
+    }
+}
+
 /// The seed paper's conditions on the layered scene: the eye focused on the far plane, a 5 mm
 /// pupil, kernels computed afresh (no cache).
 pub(crate) fn paper_conditions() -> (EyeState, Screen, KernelOptions) {
@@ -87,14 +99,7 @@ const BARS_DB: [(&str, f64); 4] = [
 fn four_preset_eyes_match_the_ground_truth() {
     let ctx = common::gpu();
     let (color, depth) = layered();
-    let input = FrameInput {
-        width: W,
-        height: H,
-        color: &color,
-        depth_m: &depth,
-        fov_y_deg: FOV_Y_DEG,
-        hidden_layers: &[],
-    };
+    let input = layered_input(&color, &depth);
     let (state, screen, options) = paper_conditions();
     for (name, bar_db) in BARS_DB {
         let eye = resolve(name).unwrap().eye;
