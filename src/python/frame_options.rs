@@ -1,32 +1,12 @@
-//! One frame's options from Python, checked with the CLI's messages, and the focus, pupil and
-//! accommodation resolved from them and the frame as `ocular render` resolves them.
+//! One frame's options from Python, checked with the CLI's messages; `render::live` resolves
+//! focus, pupil and accommodation from them as `ocular render` does.
 
-use crate::eye::age::HofstetterLine;
-use crate::eye::Eye;
-use crate::render::frame::{HostFrame, Method};
-use crate::render::frame_plan::{
-    self, Correction, FocusAsked, Physiology, PupilAsked, PupilFallback, PupilModel,
-};
+use crate::render::frame::Method;
+use crate::render::frame_plan::{self, FocusAsked};
+use crate::render::live::LiveOptions;
 use crate::{Error, Result};
 
 use super::eye::check_pupil;
-
-/// The options of one frame, already checked where Python gave them.
-pub(super) struct Options {
-    pub(super) focus_m: Option<f64>,
-    pub(super) focus_d: Option<f64>,
-    pub(super) focus_at: Option<(u32, u32)>,
-    pub(super) pupil_mm: Option<f64>,
-    pub(super) luminance_cdm2: Option<f64>,
-    pub(super) age: f64,
-    pub(super) method: Method,
-    pub(super) layers: u32,
-    pub(super) off_axis: bool,
-    /// The exposure the image will be shown at (EV; None: the frame's automatic one).
-    pub(super) exposure_ev: Option<f64>,
-    /// The speed/accuracy preset (`--quality`).
-    pub(super) quality: crate::render::splat::Quality,
-}
 
 fn parse_quality(name: &str) -> Result<crate::render::splat::Quality> {
     // the CLI's own parser of `--quality`, case-insensitive
@@ -64,7 +44,7 @@ pub(super) fn options(
     off_axis: bool,
     exposure_ev: Option<f64>,
     quality: &str,
-) -> Result<Options> {
+) -> Result<LiveOptions> {
     let quality = parse_quality(quality)?;
     let given = [focus_m.is_some(), focus_d.is_some(), focus_at.is_some()];
     if given.iter().filter(|g| **g).count() > 1 {
@@ -115,10 +95,12 @@ pub(super) fn options(
             )));
         }
     }
-    Ok(Options {
-        focus_m,
-        focus_d,
-        focus_at,
+    let focus = focus_m
+        .map(FocusAsked::DistanceM)
+        .or(focus_d.map(FocusAsked::Dioptres))
+        .or(focus_at.map(|(x, y)| FocusAsked::AtPixel(x, y)));
+    Ok(LiveOptions {
+        focus,
         pupil_mm,
         luminance_cdm2,
         age,
@@ -127,39 +109,6 @@ pub(super) fn options(
         off_axis,
         exposure_ev,
         quality,
+        correction: Default::default(),
     })
-}
-
-/// The focus vergence and the words naming its source, as `ocular render` decides (a focus
-/// nearer than ocular renders is refused).
-pub(super) fn focus_dioptres(o: &Options, f: &HostFrame) -> Result<(f64, String)> {
-    let asked = o
-        .focus_m
-        .map(FocusAsked::DistanceM)
-        .or(o.focus_d.map(FocusAsked::Dioptres))
-        .or(o.focus_at.map(|(x, y)| FocusAsked::AtPixel(x, y)));
-    f.focus_d(asked)
-}
-
-/// The pupil as `ocular render` picks it: given, else Watson–Yellott at the luminance given,
-/// the scene's pupil or luminance, or the frame's mean luminance.
-pub(super) fn pupil_diameter(o: &Options, f: &HostFrame) -> Result<(f64, String)> {
-    let asked = PupilAsked {
-        given_mm: o.pupil_mm,
-        luminance_cdm2: o.luminance_cdm2.map(|l| (l, "luminance_cdm2")),
-        model: PupilModel::WatsonYellott,
-        age_years: o.age,
-        fallback: PupilFallback::Luminance,
-    };
-    f.pupil_mm(&asked)
-}
-
-/// The eye as the CLI renders it: with the age's amplitude of accommodation unless its file
-/// sets one (a correction the eye carries stays).
-pub(super) fn physiology(eye: &Eye, age: f64) -> Result<(Eye, Physiology)> {
-    frame_plan::corrected_eye(
-        eye,
-        &Correction::default(),
-        Some((age, HofstetterLine::Mean)),
-    )
 }

@@ -12,6 +12,7 @@ pub(crate) mod focus;
 pub(crate) mod frame;
 pub(crate) mod frame_plan;
 pub(crate) mod judge;
+pub(crate) mod live;
 pub(crate) mod projection;
 pub(crate) mod raster;
 pub mod reference;
