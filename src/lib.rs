@@ -20,6 +20,7 @@ pub mod psf;
 mod python;
 pub mod render;
 pub mod scene;
+pub mod viewer;
 
 /// SPIR-V of every shader under `glsl/`, compiled by build.rs.
 pub mod shaders {

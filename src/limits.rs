@@ -59,6 +59,10 @@ impl Limit {
     }
 }
 
+/// Smallest frame side the eye-rendering front doors accept: the kernel grid's screen needs at
+/// least 16 pixels of height, and the SSIM window 11 pixels of each side.
+pub const MIN_FRAME_SIDE: u32 = 16;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -22,6 +22,7 @@ mod raster;
 mod refract;
 pub(crate) mod render;
 mod render_output;
+mod serve;
 mod sha256;
 mod video;
 mod video_files;
@@ -71,6 +72,8 @@ pub enum Command {
     Eye(Box<eye::EyeArgs>),
     /// PSNR, SSIM and FLIP between two images (HDR-FLIP for EXR), with an error map.
     Metrics(Box<metrics::MetricsArgs>),
+    /// The live viewer: a local web page that changes the eye, focus and pupil and shows the frame.
+    Serve(Box<serve::ServeArgs>),
 }
 
 impl Cli {
@@ -115,6 +118,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Kernels(args) => refuse_device(&cli, "kernels").and_then(|()| kernels::run(args)),
         Command::Eye(args) => refuse_device(&cli, "eye").and_then(|()| eye::run(args)),
         Command::Metrics(args) => refuse_device(&cli, "metrics").and_then(|()| metrics::run(args)),
+        Command::Serve(args) => serve::run(&cli, args),
     }
 }
 

@@ -74,9 +74,7 @@ pub(crate) fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> 
     Ok((parse(w)?, parse(h)?))
 }
 
-/// Smallest frame side the eye-rendering commands accept: the kernel grid's screen needs at
-/// least 16 pixels of height, and the SSIM window 11 pixels of each side.
-pub const MIN_FRAME_SIDE: u32 = 16;
+pub use crate::limits::MIN_FRAME_SIDE;
 
 /// `WxH` for the commands that render through an eye (render, video, compare, bench): the
 /// parser states the limit the renderer enforces.

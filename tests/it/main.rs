@@ -64,5 +64,6 @@ mod slices;
 mod splat;
 mod splat_presets;
 mod splat_real_kernels;
+mod viewer;
 mod views;
 mod wide_field;
