@@ -19,7 +19,11 @@ packages=(
     libshaderc-dev glslang-dev spirv-tools glslc
     pkg-config binutils ca-certificates
     python3 python3-venv python3-pip
+    chromium
 )
+# The viewer's browser test (tests/viewer/) runs on Node: Debian's, unless one is installed.
+command -v node >/dev/null || packages+=(nodejs)
+command -v npm >/dev/null || packages+=(npm)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
@@ -67,6 +71,18 @@ else
     printf '%s' "$want" > "$stamp"
     # shaderc-sys caches the library location: make it look again.
     (cd "$here" && cargo clean -p shaderc-sys >/dev/null 2>&1) || true
+fi
+
+# playwright-core for the viewer's browser test, at the version package-lock.json pins; it
+# drives Debian's chromium (its own browser download is never used).
+viewer="$here/tests/viewer"
+want=$(node -p "require('$viewer/package-lock.json').packages['node_modules/playwright-core'].version")
+have=$(node -p "require('$viewer/node_modules/playwright-core/package.json').version" 2>/dev/null || true)
+if [ "$want" == "$have" ]; then
+    say "playwright-core $have already installed"
+else
+    say "installing playwright-core (npm ci in tests/viewer)"
+    (cd "$viewer" && PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD=1 npm ci --no-audit --no-fund --loglevel=error >/dev/null)
 fi
 
 say "done. Vulkan devices visible to the loader:"

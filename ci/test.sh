@@ -14,3 +14,9 @@ export OCULAR_VALIDATION=required
 
 # Library, binary and integration tests; benchmarks are built by clippy and run by `cargo bench`.
 cargo test --release "$@"
+
+# The live viewer in a real browser (Debian's chromium through playwright-core): the page, a
+# focus click, a bad and a good prescription, a comparison, an export (docs/viewer.md).
+if [ $# -eq 0 ]; then
+    node tests/viewer/e2e.mjs
+fi
