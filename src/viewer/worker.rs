@@ -404,7 +404,11 @@ impl Worker {
             Ok(b) => b,
             Err(e) => return self.hub.send_error(id, 0, &format!("export: {e}")),
         };
-        let file = format!("ocular-{}.{ext}", request.scene);
+        let file = match (request.sides.len(), side) {
+            (1, _) => format!("ocular-{}.{ext}", request.scene),
+            (_, 0) => format!("ocular-{}-a.{ext}", request.scene),
+            _ => format!("ocular-{}-b.{ext}", request.scene),
+        };
         let header = serde_json::json!({
             "type": "export",
             "format": ext,

@@ -344,8 +344,14 @@ fn the_command_line_it_gives_renders_the_same_frame() {
     assert!(command.starts_with("ocular render "), "{command}");
     // Run it as a user would, in a shell, with this build's binary first on the PATH.
     let dir = crate::common::temp_dir("command");
-    let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_ocular")).parent().unwrap();
-    let path = format!("{}:{}", bin_dir.display(), std::env::var("PATH").unwrap_or_default());
+    let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_ocular"))
+        .parent()
+        .unwrap();
+    let path = format!(
+        "{}:{}",
+        bin_dir.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
     let out = std::process::Command::new("sh")
         .arg("-c")
         .arg(format!("{command} --cache {}", module_cache().display()))
@@ -353,7 +359,11 @@ fn the_command_line_it_gives_renders_the_same_frame() {
         .env("PATH", path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let decode = |bytes: &[u8]| image::load_from_memory(bytes).unwrap().to_rgb8();
     let ours = decode(&png);
     let cli = decode(&std::fs::read(dir.join("ocular.png")).unwrap());
@@ -364,9 +374,15 @@ fn the_command_line_it_gives_renders_the_same_frame() {
         .flat_map(|(a, b)| (0..3).map(move |c| (i16::from(a[c]) - i16::from(b[c])).abs()))
         .max()
         .unwrap();
-    assert!(worst <= 1, "the viewer's frame and its command's differ by {worst} of 255");
+    assert!(
+        worst <= 1,
+        "the viewer's frame and its command's differ by {worst} of 255"
+    );
     // The summary agrees with the CLI's on where the eye focused.
     let stdout = String::from_utf8_lossy(&out.stdout);
     let reached = header["summary"]["focus"]["actual_d"].as_f64().unwrap();
-    assert!(stdout.contains(&format!("{:.3} m", 1.0 / reached)), "{stdout} vs {reached}");
+    assert!(
+        stdout.contains(&format!("{:.3} m", 1.0 / reached)),
+        "{stdout} vs {reached}"
+    );
 }

@@ -93,11 +93,18 @@ try {
   const a = await page.evaluate(() => window.ocularViewer.summaries[0]);
   check(a.correction == null, "the first eye stays uncorrected");
 
-  // Export the frame as EXR: a file with the EXR magic number.
-  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#export-exr")]);
-  const file = await download.path();
-  const magic = readFileSync(file).subarray(0, 4);
-  check(magic.equals(Buffer.from([0x76, 0x2f, 0x31, 0x01])), `EXR export ${download.suggestedFilename()} is an OpenEXR file`);
+  // Export both frames as EXR: two files with the EXR magic number.
+  const downloads = [];
+  page.on("download", (d) => downloads.push(d));
+  await page.click("#export-exr");
+  await page.waitForFunction(() => /exported .*-b\.exr/.test(document.getElementById("status").textContent), null, { timeout: 30000 });
+  await new Promise((r) => setTimeout(r, 500));
+  const names = downloads.map((d) => d.suggestedFilename()).sort();
+  check(names.join(",") === "ocular-primitives-a.exr,ocular-primitives-b.exr", `both frames exported (${names.join(", ")})`);
+  for (const d of downloads) {
+    const magic = readFileSync(await d.path()).subarray(0, 4);
+    check(magic.equals(Buffer.from([0x76, 0x2f, 0x31, 0x01])), `${d.suggestedFilename()} is an OpenEXR file`);
+  }
 
   mkdirSync(dirname(screenshot), { recursive: true });
   await page.evaluate(() => { document.getElementById("controls").scrollTop = 0; });

@@ -392,10 +392,11 @@ async function start() {
   connect();
 }
 
+// The shown frame (both, when comparing) as files.
 function exportFrame(format) {
-  if (state.ws && state.ws.readyState === WebSocket.OPEN) {
-    state.ws.send(JSON.stringify({ type: "export", format, side: 0 }));
-  }
+  if (!state.ws || state.ws.readyState !== WebSocket.OPEN) return;
+  const sides = $("compare").value === "off" ? [0] : [0, 1];
+  for (const side of sides) state.ws.send(JSON.stringify({ type: "export", format, side }));
 }
 
 start().catch((e) => { setStatus(`cannot start: ${e}`, true); });
