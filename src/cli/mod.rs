@@ -6,6 +6,7 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod bench;
+mod binocular;
 mod compare;
 mod compare_files;
 pub(crate) mod correction;

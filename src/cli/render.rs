@@ -71,9 +71,25 @@ pub struct RenderArgs {
     /// Render NaN or infinite colour samples of --color as black instead of refusing the file.
     #[arg(long, requires = "color")]
     pub repair_nonfinite: bool,
-    /// Eye: a preset (see `ocular eye list`) or an eye .toml file.
+    /// Eye: a preset (see `ocular eye list`) or an eye .toml file. With --eye-right, the left
+    /// eye.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
+    /// Render the scene through two eyes (--eye for both, or the left with --eye-right): the
+    /// scene's camera is the point between them, both converge on the focus point and share
+    /// one accommodation (docs/binocular.md).
+    #[arg(long)]
+    pub binocular: bool,
+    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub eye_right: Option<String>,
+    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub ipd_mm: Option<f64>,
+    /// How a binocular pair is written (default separate: -o view.png writes view-left.png
+    /// and view-right.png).
+    #[arg(long, value_enum)]
+    pub stereo: Option<super::binocular::StereoOutput>,
     /// Focus distance in metres (`inf` for infinity).
     #[arg(long, value_name = "M", conflicts_with_all = ["focus_d", "focus_at"], allow_hyphen_values = true)]
     pub focus_m: Option<String>,
@@ -215,7 +231,7 @@ fn render_frame(
 
 /// The options checked on their own, before any file or device is opened; the splat
 /// settings they give.
-fn check_args(args: &RenderArgs) -> Result<crate::render::splat::SplatSettings> {
+pub(super) fn check_args(args: &RenderArgs) -> Result<crate::render::splat::SplatSettings> {
     let output_ext = args
         .output
         .extension()
@@ -429,7 +445,7 @@ pub(crate) fn load_eye(spec: &str) -> Result<Eye> {
 pub(crate) use crate::render::frame_plan::parse_age_years;
 
 /// The focus the options ask for; the rest of the decision is `frame_plan::focus_d`'s.
-fn focus_asked(args: &RenderArgs) -> Result<Option<FocusAsked>> {
+pub(super) fn focus_asked(args: &RenderArgs) -> Result<Option<FocusAsked>> {
     if let Some(text) = &args.focus_m {
         let t = text.trim().to_ascii_lowercase();
         if t == "inf" || t == "infinity" {
@@ -459,6 +475,10 @@ fn pupil_asked(args: &RenderArgs) -> PupilAsked<'static> {
 }
 
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
+    super::binocular::check(args)?;
+    if super::binocular::asked(args) {
+        return super::binocular::run(cli, args);
+    }
     let mut splat = check_args(args)?;
     let (eye, physiology) = args.correction.apply(
         &load_eye(&args.eye)?,

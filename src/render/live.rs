@@ -21,6 +21,7 @@ use crate::render::frame_plan::{
 };
 use crate::render::splat::{Quality, SplatSettings};
 use crate::render::Rasterizer;
+use crate::scene::Camera;
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -142,8 +143,28 @@ pub struct Counters {
     pub kernel_preparations: u64,
 }
 
-/// Scene name, time (bits), size and spectacle magnification of a host frame.
-type HostKey = (String, u64, (u32, u32), Option<[[f64; 2]; 2]>);
+/// Scene name, time (bits), size, spectacle magnification and camera (bits) of a host frame.
+type HostKey = (
+    String,
+    u64,
+    (u32, u32),
+    Option<[[f64; 2]; 2]>,
+    Option<[u64; 7]>,
+);
+
+/// A camera as exact bits, for cache keys.
+fn camera_bits(c: Camera) -> [u64; 7] {
+    [
+        c.position_m[0],
+        c.position_m[1],
+        c.position_m[2],
+        c.yaw_deg,
+        c.pitch_deg,
+        c.fov_y_deg,
+        c.near_m,
+    ]
+    .map(f64::to_bits)
+}
 
 /// Host frames kept: a preview and a full frame, for each of two eyes in a comparison.
 const HOST_FRAMES_KEPT: usize = 4;
@@ -253,11 +274,31 @@ impl LiveRenderer {
         size: Option<(u32, u32)>,
         time_s: f64,
     ) -> Result<(LiveFrame, Vec<String>)> {
+        self.render_scene_from(scene, eye, o, size, time_s, None)
+    }
+
+    /// [`render_scene`](Self::render_scene) from `camera` instead of the scene's own (an eye
+    /// of a binocular pair: `render::binocular`).
+    pub fn render_scene_from(
+        &self,
+        scene: SceneArg<'_>,
+        eye: &Eye,
+        o: &LiveOptions,
+        size: Option<(u32, u32)>,
+        time_s: f64,
+        camera: Option<Camera>,
+    ) -> Result<(LiveFrame, Vec<String>)> {
         let (eye, physiology) = physiology(eye, o)?;
-        let (frame, warnings) =
-            self.scene_frame(scene, physiology.spectacle_magnification, size, time_s)?;
+        let (frame, warnings) = self.scene_frame_from(
+            scene,
+            physiology.spectacle_magnification,
+            size,
+            time_s,
+            camera,
+        )?;
         let key = scene.key();
-        let live = self.render_corrected(&eye, physiology, o, &frame, Some((&key, time_s)))?;
+        let live =
+            self.render_corrected(&eye, physiology, o, &frame, Some((&key, time_s, camera)))?;
         Ok((live, warnings))
     }
 
@@ -269,7 +310,7 @@ impl LiveRenderer {
         physiology: Physiology,
         o: &LiveOptions,
         frame: &HostFrame,
-        scene: Option<(&str, f64)>,
+        scene: Option<(&str, f64, Option<Camera>)>,
     ) -> Result<LiveFrame> {
         let (focus_d, focus_from) = frame.focus_d(o.focus)?;
         let (pupil_mm, pupil_from) = pupil_diameter(o, frame)?;
@@ -351,11 +392,14 @@ impl LiveRenderer {
         );
         renderer.set_display_white(crate::render::splat::display_white(exposure_ev));
         let rendered = match (scene, rasterizer.as_mut(), loaded.as_ref()) {
-            (Some((name, time_s)), Some(raster), Some((loaded_name, scene)))
+            (Some((name, time_s, camera)), Some(raster), Some((loaded_name, scene)))
                 if o.method == Method::Splat && name == loaded_name =>
             {
                 let gap_d = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D;
-                let scene_state = scene.at_time(time_s);
+                let mut scene_state = scene.at_time(time_s);
+                if let Some(c) = camera {
+                    scene_state.camera = c;
+                }
                 // the magnification the host frame was drawn with
                 raster.set_view_magnification(
                     physiology
@@ -405,6 +449,18 @@ impl LiveRenderer {
         size: Option<(u32, u32)>,
         time_s: f64,
     ) -> Result<(HostFrame, Vec<String>)> {
+        self.scene_frame_from(scene, magnification, size, time_s, None)
+    }
+
+    /// [`scene_frame`](Self::scene_frame) from `camera` instead of the scene's own.
+    pub fn scene_frame_from(
+        &self,
+        scene: SceneArg<'_>,
+        magnification: Option<[[f64; 2]; 2]>,
+        size: Option<(u32, u32)>,
+        time_s: f64,
+        camera: Option<Camera>,
+    ) -> Result<(HostFrame, Vec<String>)> {
         if !(time_s.is_finite() && time_s >= 0.0) {
             return Err(Error::input(format!(
                 "--time {time_s} must be a non-negative number of seconds"
@@ -429,7 +485,13 @@ impl LiveRenderer {
         }
         let scene_resolution = inner.scene.as_ref().expect("loaded above").1.resolution;
         let size_px = size.unwrap_or((scene_resolution[0], scene_resolution[1]));
-        let host_key: HostKey = (name.to_string(), time_s.to_bits(), size_px, magnification);
+        let host_key: HostKey = (
+            name.to_string(),
+            time_s.to_bits(),
+            size_px,
+            magnification,
+            camera.map(camera_bits),
+        );
         if let Some(i) = inner.host.iter().position(|(k, _, _)| *k == host_key) {
             let kept = inner.host.remove(i);
             let out = (kept.1.clone(), kept.2.clone());
@@ -447,7 +509,10 @@ impl LiveRenderer {
             &scene.as_ref().expect("loaded above").1,
         );
         raster.set_view_magnification(magnification.unwrap_or([[1.0, 0.0], [0.0, 1.0]]));
-        let state = scene.at_time(time_s);
+        let mut state = scene.at_time(time_s);
+        if let Some(c) = camera {
+            state.camera = c;
+        }
         let (width, height) = size_px;
         let drawn = raster.render(&self.ctx, &state, width, height)?;
         let mut depth_m = drawn.depth_m;

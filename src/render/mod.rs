@@ -6,6 +6,7 @@
 //! [`views`], three other renderers whose entry point is each called `render` (re-exporting
 //! them would collide).
 
+pub mod binocular;
 pub(crate) mod blend;
 pub(crate) mod edge_band;
 pub(crate) mod focus;

@@ -5,6 +5,7 @@
 mod common;
 
 mod aberration_files;
+mod binocular;
 mod blend;
 mod cli_basics;
 mod cli_corrections;

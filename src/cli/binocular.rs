@@ -1,0 +1,421 @@
+//! `ocular render --binocular` (or `--eye-right`): a scene through two eyes. The scene's camera
+//! is the point between them; both eyes converge on the fixation point (the focus asked) and
+//! accommodate by one shared response (`render::binocular`); their pupils are one too (the
+//! consensual reflex: both from the same light). Written as two files, side by side, or a
+//! red-cyan anaglyph.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::render::RenderArgs;
+use super::Cli;
+use crate::eye::Eye;
+use crate::gpu::Context;
+use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::render::binocular::{self, Yoke, SIDES};
+use crate::render::focus::effective_focus;
+use crate::render::frame::Method;
+use crate::render::frame_plan::{Correction, FocusAsked};
+use crate::render::live::{self, LiveOptions, LiveRenderer, SceneArg};
+use crate::scene::{Camera, Scene};
+use crate::{Error, Result};
+
+/// How a binocular pair is written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StereoOutput {
+    /// Two files: `-o view.png` writes view-left.png and view-right.png.
+    Separate,
+    /// One file, the left eye's frame on the left (for parallel free-viewing and most
+    /// stereo viewers).
+    SideBySide,
+    /// One red-cyan anaglyph: red from the left eye, green and blue from the right.
+    Anaglyph,
+}
+
+/// Whether the options ask for two eyes.
+pub fn asked(args: &RenderArgs) -> bool {
+    args.binocular || args.eye_right.is_some()
+}
+
+/// Refuses the binocular options without a binocular render, and what it cannot take yet.
+pub fn check(args: &RenderArgs) -> Result<()> {
+    if !asked(args) {
+        let stray = [
+            ("--ipd-mm", args.ipd_mm.is_some()),
+            ("--stereo", args.stereo.is_some()),
+        ];
+        if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
+            return Err(Error::input(format!(
+                "{name} applies to two eyes: add --binocular (or --eye-right)"
+            )));
+        }
+        return Ok(());
+    }
+    if args.color.is_some() {
+        return Err(Error::input(
+            "--binocular renders a scene from two eye positions; a --color frame has one view",
+        ));
+    }
+    if args.method != Method::Splat {
+        return Err(Error::input("--binocular renders with --method splat"));
+    }
+    if args.splat.off_axis {
+        return Err(Error::input(
+            "--binocular does not take --off-axis yet (each eye's field would need its own plan)",
+        ));
+    }
+    if let Some(ipd) = args.ipd_mm {
+        let (lo, hi) = binocular::IPD_RANGE_MM;
+        if !(ipd.is_finite() && (lo..=hi).contains(&ipd)) {
+            return Err(Error::input(format!(
+                "--ipd-mm {ipd} is outside {lo} to {hi} mm"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The output file of one eye (`separate`) or of the pair.
+pub fn eye_output(output: &Path, side: &str) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "ocular".into());
+    let ext = output
+        .extension()
+        .map(|e| e.to_string_lossy().to_string())
+        .unwrap_or_else(|| "png".into());
+    output.with_file_name(format!("{stem}-{side}.{ext}"))
+}
+
+/// Where the eyes look: the point of the focus asked, along its pixel's ray (`--focus-at`) or
+/// straight ahead; None at infinity. Returns the point and the words naming it.
+fn fixation(
+    camera: &Camera,
+    frame: &crate::render::frame::HostFrame,
+    asked: Option<FocusAsked>,
+) -> Result<(Option<[f64; 3]>, String)> {
+    let (vergence_d, from) = frame.focus_d(asked)?;
+    if vergence_d <= 0.0 {
+        return Ok((None, from));
+    }
+    let distance_m = 1.0 / vergence_d;
+    let f = camera.forward();
+    let direction = match asked {
+        Some(FocusAsked::AtPixel(x, y)) => {
+            let yaw = camera.yaw_deg.to_radians();
+            let r = [yaw.cos(), 0.0, -yaw.sin()];
+            let u = [
+                r[1] * f[2] - r[2] * f[1],
+                r[2] * f[0] - r[0] * f[2],
+                r[0] * f[1] - r[1] * f[0],
+            ];
+            let focal = camera.focal_length_px(frame.height);
+            let tx = (f64::from(x) + 0.5 - 0.5 * f64::from(frame.width)) / focal;
+            let ty = (0.5 * f64::from(frame.height) - f64::from(y) - 0.5) / focal;
+            let d = [0, 1, 2].map(|k| f[k] + tx * r[k] + ty * u[k]);
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            d.map(|c| c / n)
+        }
+        _ => f,
+    };
+    let p = [0, 1, 2].map(|k| camera.position_m[k] + distance_m * direction[k]);
+    Ok((Some(p), from))
+}
+
+/// One eye's result.
+#[derive(serde::Serialize)]
+struct EyeSummary {
+    side: &'static str,
+    eye: String,
+    output: Option<String>,
+    position_m: [f64; 3],
+    yaw_deg: f64,
+    pitch_deg: f64,
+    demand_d: f64,
+    far_point_d: f64,
+    accommodation_max_d: Option<f64>,
+    focus_d: f64,
+    residual_defocus_d: f64,
+    correction: Option<String>,
+    seconds_render: f64,
+    seconds_kernels: f64,
+}
+
+#[derive(serde::Serialize)]
+struct Summary {
+    scene: String,
+    width: u32,
+    height: u32,
+    ipd_mm: f64,
+    fixation_m: Option<[f64; 3]>,
+    fixation_from: String,
+    /// Angle between the two lines of sight (degrees).
+    vergence_deg: f64,
+    pupil_mm: f64,
+    pupil_source: String,
+    yoke: Yoke,
+    driver: &'static str,
+    stereo: &'static str,
+    outputs: Vec<String>,
+    eyes: Vec<EyeSummary>,
+    device: String,
+}
+
+pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
+    super::render::check_args(args)?;
+    let quality = args.splat.quality;
+    let specs = [
+        args.eye.clone(),
+        args.eye_right.clone().unwrap_or_else(|| args.eye.clone()),
+    ];
+    let eyes: Vec<Eye> = specs
+        .iter()
+        .map(|s| super::render::load_eye(s))
+        .collect::<Result<_>>()?;
+    let ipd_mm = args.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM);
+    let name = args.scene.clone().unwrap_or_else(|| "primitives".into());
+    let scene = Arc::new(Scene::load(&name)?);
+    if !(args.time.is_finite() && args.time >= 0.0) {
+        return Err(Error::input(format!(
+            "--time {} must be a non-negative number of seconds",
+            args.time
+        )));
+    }
+    let c = &args.correction;
+    let correction = Correction {
+        spectacle: c.correct,
+        vertex_mm: c.vertex_mm,
+        contact: c.correct_contact,
+        iol: c.iol_d,
+        accommodation_max_d: c.accommodation_max_d,
+    };
+    let base = LiveOptions {
+        pupil_mm: args.pupil_mm,
+        luminance_cdm2: args.luminance_cdm2,
+        age: args.age,
+        layers: args.layers.unwrap_or(1),
+        exposure_ev: args.exposure.map(f64::from),
+        quality,
+        correction,
+        ..LiveOptions::default()
+    };
+    let ctx = Context::new(&cli.context_options())?;
+    let live = LiveRenderer::new(ctx, args.cache.dir(), 2);
+    let state = scene.at_time(args.time);
+    let camera = state.camera;
+    let size = args
+        .size
+        .unwrap_or((scene.resolution[0], scene.resolution[1]));
+    // The cyclopean frame: where the eyes look, the pupil both share, the exposure both show.
+    let (centre, warnings) =
+        live.scene_frame(SceneArg::Loaded(&scene), None, Some(size), args.time)?;
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    let (fixation_m, fixation_from) =
+        fixation(&camera, &centre, super::render::focus_asked(args)?)?;
+    let (pupil_mm, pupil_source) = live::pupil_diameter(&base, &centre)?;
+    let exposure_ev = args
+        .exposure
+        .unwrap_or_else(|| Tonemap::auto_exposure_ev_of(&centre.color));
+    let positions = binocular::eye_positions(&camera, ipd_mm * 1e-3);
+    let cameras = binocular::eye_cameras(&camera, ipd_mm * 1e-3, fixation_m);
+    let demand = binocular::demands_d(&positions, fixation_m);
+    let settings = crate::psf::axes::KernelSettings::default();
+    let mut far_point = [0.0; 2];
+    let mut amplitude = [None; 2];
+    let mut corrections = [None, None];
+    for e in 0..2 {
+        let (corrected, physiology) = live::physiology(&eyes[e], &base)?;
+        far_point[e] =
+            effective_focus(&corrected, 0.0, pupil_mm, &settings, "the far point")?.actual_d;
+        amplitude[e] = physiology.accommodation_max_d;
+        corrections[e] = physiology.correction;
+    }
+    let yoke = binocular::yoke(demand, far_point, amplitude);
+    let mut frames = Vec::new();
+    let mut summaries = Vec::new();
+    for e in 0..2 {
+        let o = LiveOptions {
+            focus: Some(FocusAsked::Dioptres(yoke.focus_d[e])),
+            pupil_mm: Some(pupil_mm),
+            luminance_cdm2: None,
+            exposure_ev: Some(f64::from(exposure_ev)),
+            ..base.clone()
+        };
+        let (frame, _) = live.render_scene_from(
+            SceneArg::Loaded(&scene),
+            &eyes[e],
+            &o,
+            Some(size),
+            args.time,
+            Some(cameras[e]),
+        )?;
+        for w in &frame.report.warnings {
+            eprintln!("warning: {} eye: {w}", SIDES[e]);
+        }
+        summaries.push(EyeSummary {
+            side: SIDES[e],
+            eye: specs[e].clone(),
+            output: None,
+            position_m: positions[e],
+            yaw_deg: cameras[e].yaw_deg,
+            pitch_deg: cameras[e].pitch_deg,
+            demand_d: demand[e],
+            far_point_d: far_point[e],
+            accommodation_max_d: amplitude[e],
+            focus_d: frame.report.focus.actual_d,
+            residual_defocus_d: yoke.residual_d[e],
+            correction: corrections[e].clone(),
+            seconds_render: frame.report.seconds_render,
+            seconds_kernels: frame.report.seconds_kernels,
+        });
+        frames.push(frame.color);
+    }
+    let stereo = args.stereo.unwrap_or(StereoOutput::Separate);
+    let outputs = write(args, stereo, size, &frames, exposure_ev)?;
+    if stereo == StereoOutput::Separate {
+        for (s, o) in summaries.iter_mut().zip(&outputs) {
+            s.output = Some(o.clone());
+        }
+    }
+    let lines_of_sight = cameras.map(|c| c.forward());
+    let cos = (0..3)
+        .map(|k| lines_of_sight[0][k] * lines_of_sight[1][k])
+        .sum::<f64>()
+        .clamp(-1.0, 1.0);
+    let summary = Summary {
+        scene: name,
+        width: size.0,
+        height: size.1,
+        ipd_mm,
+        fixation_m,
+        fixation_from,
+        vergence_deg: cos.acos().to_degrees(),
+        pupil_mm,
+        pupil_source,
+        yoke,
+        driver: SIDES[yoke.driver],
+        stereo: match stereo {
+            StereoOutput::Separate => "separate",
+            StereoOutput::SideBySide => "side-by-side",
+            StereoOutput::Anaglyph => "anaglyph",
+        },
+        outputs,
+        eyes: summaries,
+        device: live.device(),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary)
+                .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?
+        );
+        return Ok(());
+    }
+    print(&summary);
+    Ok(())
+}
+
+fn distance(d: f64) -> String {
+    if d > 0.0 {
+        format!("{:.3} m ({d:.2} D)", 1.0 / d)
+    } else {
+        "infinity".into()
+    }
+}
+
+fn print(s: &Summary) {
+    println!(
+        "wrote {} ({}×{}, scene {}, two eyes {:.1} mm apart converging {:.2}° on {} from {}; \
+         pupils {:.2} mm from {})",
+        s.outputs.join(", "),
+        s.width,
+        s.height,
+        s.scene,
+        s.ipd_mm,
+        s.vergence_deg,
+        s.fixation_m
+            .map_or("infinity".into(), |_| distance(s.eyes[0].demand_d)),
+        s.fixation_from,
+        s.pupil_mm,
+        s.pupil_source,
+    );
+    println!(
+        "  accommodation {:.2} D, driven by the {} eye",
+        s.yoke.accommodation_d, s.driver
+    );
+    for e in &s.eyes {
+        println!(
+            "  {:<5} eye {}: focused at {}, defocus at the target {:+.2} D (far point {}){}",
+            e.side,
+            e.eye,
+            distance(e.focus_d),
+            e.residual_defocus_d,
+            distance(e.far_point_d),
+            e.correction
+                .as_ref()
+                .map(|c| format!(", through {c}"))
+                .unwrap_or_default()
+        );
+    }
+}
+
+/// Writes the pair as asked; returns the files written.
+fn write(
+    args: &RenderArgs,
+    stereo: StereoOutput,
+    (w, h): (u32, u32),
+    frames: &[Vec<[f32; 4]>],
+    exposure_ev: f32,
+) -> Result<Vec<String>> {
+    let exr = args
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let mode = match args.tonemap {
+        super::raster::TonemapArg::Clamp => TonemapMode::Clamp,
+        super::raster::TonemapArg::Reinhard => TonemapMode::Reinhard,
+    };
+    let save = |path: &Path, image: &ImageRgba| {
+        if exr {
+            image_io::write_exr_rgba(path, image)
+        } else {
+            image_io::write_png(path, image, Tonemap { exposure_ev, mode })
+        }
+    };
+    let images: Vec<(PathBuf, ImageRgba)> = match stereo {
+        StereoOutput::Separate => (0..2)
+            .map(|e| {
+                (
+                    eye_output(&args.output, SIDES[e]),
+                    ImageRgba::new(w, h, frames[e].clone()),
+                )
+            })
+            .collect(),
+        StereoOutput::SideBySide => {
+            let mut pixels = Vec::with_capacity(2 * frames[0].len());
+            for row in 0..h as usize {
+                for f in frames {
+                    pixels.extend_from_slice(&f[row * w as usize..(row + 1) * w as usize]);
+                }
+            }
+            vec![(args.output.clone(), ImageRgba::new(2 * w, h, pixels))]
+        }
+        StereoOutput::Anaglyph => {
+            let pixels = frames[0]
+                .iter()
+                .zip(&frames[1])
+                .map(|(l, r)| [l[0], r[1], r[2], 1.0])
+                .collect();
+            vec![(args.output.clone(), ImageRgba::new(w, h, pixels))]
+        }
+    };
+    let mut written = Vec::new();
+    for (path, image) in images {
+        save(&path, &image)?;
+        written.push(path.display().to_string());
+    }
+    Ok(written)
+}

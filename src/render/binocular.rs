@@ -1,0 +1,195 @@
+//! Two eyes: where each sits and looks, and the one accommodative response they share.
+//!
+//! - Geometry. The scene's camera is the cyclopean eye, midway between the two. Each eye sits
+//!   half the interpupillary distance to its side, along the camera's horizontal right
+//!   vector, and turns (yaw and pitch, no torsion) to look at the fixation point, as the eyes
+//!   converge on what a person looks at. A fixation at infinity leaves both parallel to the
+//!   camera.
+//! - Accommodation is yoked: both lenses receive one accommodative response (in dioptres of
+//!   object vergence, from each eye's far point). The eye that can see the target sharp with
+//!   the least accommodation drives it; where neither can, the eye that comes closest does. The
+//!   other eye gets the same response, limited by its own amplitude, and keeps the defocus
+//!   that leaves ([`yoke`]). This is why monovision works: the distance eye drives for far
+//!   targets, the near eye for near ones, and each image stays blurred in the other eye.
+
+use crate::scene::Camera;
+
+/// The adult mean interpupillary distance, in millimetres: 63 mm (Dodgson, "Variation and
+/// extrema of human interpupillary distance", Proc. SPIE 5291, 2004: mean 63.4 mm for adult
+/// men and 61.7 mm for women in the 1988 US Army anthropometric survey).
+pub const DEFAULT_IPD_MM: f64 = 63.0;
+
+/// The range `--ipd-mm` accepts: the extremes Dodgson reports for adults are about 52 and
+/// 78 mm; children reach down to about 40.
+pub const IPD_RANGE_MM: (f64, f64) = (40.0, 80.0);
+
+/// Which eye: index 0 is the left, 1 the right.
+pub const SIDES: [&str; 2] = ["left", "right"];
+
+/// The camera's horizontal right vector (world +Y up, no roll).
+fn right_vector(camera: &Camera) -> [f64; 3] {
+    let yaw = camera.yaw_deg.to_radians();
+    [yaw.cos(), 0.0, -yaw.sin()]
+}
+
+/// Each eye's position (left, right), half `ipd_m` either side of the camera.
+pub fn eye_positions(camera: &Camera, ipd_m: f64) -> [[f64; 3]; 2] {
+    let r = right_vector(camera);
+    let p = camera.position_m;
+    [-0.5, 0.5].map(|s| [0, 1, 2].map(|k| p[k] + s * ipd_m * r[k]))
+}
+
+/// The point `distance_m` straight ahead of the camera; None at infinity.
+pub fn point_ahead(camera: &Camera, distance_m: f64) -> Option<[f64; 3]> {
+    if !(distance_m.is_finite() && distance_m > 0.0) {
+        return None;
+    }
+    let f = camera.forward();
+    Some([0, 1, 2].map(|k| camera.position_m[k] + distance_m * f[k]))
+}
+
+/// The eyes' cameras (left, right): at [`eye_positions`], looking at `fixation` (None:
+/// infinity, parallel to the camera). Field of view and clipping planes are the camera's.
+pub fn eye_cameras(camera: &Camera, ipd_m: f64, fixation: Option<[f64; 3]>) -> [Camera; 2] {
+    eye_positions(camera, ipd_m).map(|position_m| {
+        let mut c = *camera;
+        c.position_m = position_m;
+        if let Some(p) = fixation {
+            if let Some((yaw, pitch)) =
+                Camera::angles_towards([0, 1, 2].map(|k| p[k] - position_m[k]))
+            {
+                c.yaw_deg = yaw;
+                c.pitch_deg = pitch;
+            }
+        }
+        c
+    })
+}
+
+/// The vergence (D) of `fixation` seen from each eye: the accommodative demand of a target
+/// there (0 at infinity).
+pub fn demands_d(positions: &[[f64; 3]; 2], fixation: Option<[f64; 3]>) -> [f64; 2] {
+    positions.map(|e| match fixation {
+        Some(p) => {
+            let d = [0, 1, 2].map(|k| p[k] - e[k]);
+            1.0 / (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+        }
+        None => 0.0,
+    })
+}
+
+/// One accommodative response for two eyes.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Yoke {
+    /// The eye that drives accommodation (0 left, 1 right).
+    pub driver: usize,
+    /// The response both lenses receive (D of object vergence from each far point), before
+    /// each eye's own amplitude limits it.
+    pub accommodation_d: f64,
+    /// Where each eye then focuses (D of object vergence).
+    pub focus_d: [f64; 2],
+    /// Each eye's defocus at the target: its demand minus where it focuses (D; positive: the
+    /// eye focuses beyond the target).
+    pub residual_d: [f64; 2],
+}
+
+/// The response a person makes to a target of `demand_d` (per eye, D) with eyes whose far
+/// points are `far_point_d` (D; 0 at infinity) and amplitudes `amplitude_d` (None: unlimited).
+///
+/// Each eye alone would accommodate `demand − far point`, clamped to [0, amplitude]. The
+/// driver is the eye that reaches its target with the least accommodation; if neither
+/// reaches it, the eye left with the smaller defocus (the less accommodation on a tie).
+pub fn yoke(demand_d: [f64; 2], far_point_d: [f64; 2], amplitude_d: [Option<f64>; 2]) -> Yoke {
+    let amplitude = amplitude_d.map(|a| a.unwrap_or(f64::INFINITY).max(0.0));
+    let wanted = [0, 1].map(|e| demand_d[e] - far_point_d[e]);
+    let alone = [0, 1].map(|e| wanted[e].clamp(0.0, amplitude[e]));
+    let miss = [0, 1].map(|e| (wanted[e] - alone[e]).abs());
+    let reaches = [0, 1].map(|e| miss[e] <= 1e-9);
+    let driver = match reaches {
+        [true, true] => usize::from(alone[1] < alone[0]),
+        [true, false] => 0,
+        [false, true] => 1,
+        [false, false] => {
+            if (miss[0] - miss[1]).abs() <= 1e-9 {
+                usize::from(alone[1] < alone[0])
+            } else {
+                usize::from(miss[1] < miss[0])
+            }
+        }
+    };
+    let response = alone[driver];
+    let focus_d = [0, 1].map(|e| far_point_d[e] + response.min(amplitude[e]));
+    Yoke {
+        driver,
+        accommodation_d: response,
+        focus_d,
+        residual_d: [0, 1].map(|e| demand_d[e] - focus_d[e]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn monovision_hands_each_distance_to_its_eye() {
+        // Left emmetropic, right myopic by 1.5 D, both with 1 D of accommodation left.
+        let (fp, amp) = ([0.0, 1.5], [Some(1.0), Some(1.0)]);
+        let far = yoke([1.0 / 6.0; 2], fp, amp);
+        assert_eq!(far.driver, 0);
+        assert!((far.focus_d[0] - 1.0 / 6.0).abs() < 1e-12);
+        assert!((far.focus_d[1] - (1.5 + 1.0 / 6.0)).abs() < 1e-12);
+        assert!((far.residual_d[1] + 1.5).abs() < 1e-12);
+        let near = yoke([2.5; 2], fp, amp);
+        assert_eq!(near.driver, 1);
+        assert!((near.focus_d[1] - 2.5).abs() < 1e-12);
+        assert!((near.focus_d[0] - 1.0).abs() < 1e-12);
+        assert!((near.residual_d[0] - 1.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_eye_needing_less_drives_and_amplitudes_limit_the_other() {
+        // Both reach 2 D; the right (far point 1 D) needs less.
+        let y = yoke([2.0; 2], [0.0, 1.0], [Some(8.0), Some(8.0)]);
+        assert_eq!((y.driver, y.accommodation_d), (1, 1.0));
+        assert_eq!(y.focus_d, [1.0, 2.0]);
+        // Neither reaches 6 D: the right comes closer (4 + 1 = 5 vs 0 + 3 = 3).
+        let y = yoke([6.0; 2], [0.0, 1.0], [Some(3.0), Some(4.0)]);
+        assert_eq!(y.driver, 1);
+        assert_eq!(y.focus_d, [3.0, 5.0]);
+        // A target beyond both far points: both stay relaxed.
+        let y = yoke([0.0; 2], [0.5, 1.0], [Some(3.0), None]);
+        assert_eq!((y.accommodation_d, y.focus_d), (0.0, [0.5, 1.0]));
+    }
+
+    #[test]
+    fn eyes_sit_across_the_view_and_converge_on_the_fixation() {
+        let camera = Camera {
+            position_m: [1.0, 1.6, 2.0],
+            yaw_deg: 90.0,
+            pitch_deg: 0.0,
+            fov_y_deg: 40.0,
+            near_m: 0.01,
+            far_m: 100.0,
+        };
+        // Looking along −X, the right eye is towards −Z.
+        let [l, r] = eye_positions(&camera, 0.064);
+        assert!((l[2] - 2.032).abs() < 1e-12 && (r[2] - 1.968).abs() < 1e-12);
+        let p = point_ahead(&camera, 0.5).unwrap();
+        let [cl, cr] = eye_cameras(&camera, 0.064, Some(p));
+        // each turns inwards by atan(32 mm / 500 mm)
+        let inward = (0.032f64 / 0.5).atan().to_degrees();
+        assert!(
+            (cl.yaw_deg - (90.0 - inward)).abs() < 1e-9,
+            "{}",
+            cl.yaw_deg
+        );
+        assert!(
+            (cr.yaw_deg - (90.0 + inward)).abs() < 1e-9,
+            "{}",
+            cr.yaw_deg
+        );
+        let parallel = eye_cameras(&camera, 0.064, None);
+        assert_eq!(parallel.map(|c| c.yaw_deg), [90.0; 2]);
+    }
+}

@@ -1,0 +1,248 @@
+//! Two eyes: the pinhole geometry of converging eyes (disparity of midline points, the fixated
+//! point centred), judged on rasterised frames against the exact form written here; and the
+//! CLI's binocular render (yoked accommodation of a monovision pair, outputs, bad options).
+
+use ocular::render::binocular::{eye_cameras, eye_positions, point_ahead, DEFAULT_IPD_MM};
+use ocular::render::Rasterizer;
+use ocular::scene::Scene;
+
+use crate::common::{finish, gpu, module_cache, ocular_run, temp_dir};
+
+const SIZE: (u32, u32) = (640, 360);
+const FOV_Y_DEG: f64 = 20.0;
+
+/// A scene of one white sphere on the midline `d_m` ahead, lit evenly, on near black; its radius
+/// spans about 8 pixels at any distance.
+fn marker_scene(d_m: f64) -> Scene {
+    let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
+    let radius = d_m * 8.0 / focal;
+    let text = format!(
+        r#"
+name = "marker"
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+fov_y_deg = {FOV_Y_DEG}
+near_m = 0.05
+far_m = 50.0
+resolution = [{w}, {h}]
+[background]
+color = [1.0, 1.0, 1.0]
+luminance_cd_m2 = 0.01
+[[light]]
+kind = "ambient"
+illuminance_lux = 300.0
+[[object]]
+kind = "sphere"
+radius_m = {radius}
+segments = 256
+translate = [0.0, 0.0, {z}]
+color = [0.8, 0.8, 0.8]
+"#,
+        w = SIZE.0,
+        h = SIZE.1,
+        z = -d_m
+    );
+    Scene::from_toml(&text, "marker scene", std::path::Path::new(".")).unwrap()
+}
+
+/// The centroid of a frame's light above its background, in pixel coordinates (a pixel's
+/// centre at i + 0.5).
+fn centroid(color: &[[f32; 4]], width: u32) -> (f64, f64) {
+    let value = |p: &[f32; 4]| f64::from(p[0] + p[1] + p[2]);
+    let background = color.iter().map(value).fold(f64::INFINITY, f64::min);
+    let (mut sx, mut sy, mut s) = (0.0, 0.0, 0.0);
+    for (i, p) in color.iter().enumerate() {
+        let v = value(p) - background;
+        let (x, y) = (
+            (i as u32 % width) as f64 + 0.5,
+            (i as u32 / width) as f64 + 0.5,
+        );
+        sx += v * x;
+        sy += v * y;
+        s += v;
+    }
+    assert!(s > 0.0, "the marker is not in the frame");
+    (sx / s, sy / s)
+}
+
+#[test]
+fn midline_points_land_at_the_disparity_of_converging_eyes() {
+    let ctx = gpu();
+    let mut raster = Rasterizer::new(&ctx).unwrap();
+    let fixation_m = 2.0;
+    let b = 0.5 * DEFAULT_IPD_MM * 1e-3;
+    let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
+    let (cx, cy) = (0.5 * f64::from(SIZE.0), 0.5 * f64::from(SIZE.1));
+    for d in [0.5, 1.0, fixation_m, 4.0] {
+        let scene = marker_scene(d);
+        let mut state = scene.at_time(0.0);
+        let camera = state.camera;
+        let positions = eye_positions(&camera, 2.0 * b);
+        assert_eq!(positions[0][0], -b);
+        let cameras = eye_cameras(&camera, 2.0 * b, point_ahead(&camera, fixation_m));
+        let mut xs = [0.0; 2];
+        for (e, eye_camera) in cameras.iter().enumerate() {
+            state.camera = *eye_camera;
+            let frame = raster.render(&ctx, &state, SIZE.0, SIZE.1).unwrap();
+            let (x, y) = centroid(&frame.color, SIZE.0);
+            // Exact: an eye at x = ∓b turned by atan(b/D) towards the midline sees the point
+            // at angle atan(b/d) − atan(b/D) from its axis, on the side away from itself.
+            let angle = (b / d).atan() - (b / fixation_m).atan();
+            let sign = if e == 0 { 1.0 } else { -1.0 };
+            let expected = cx + sign * focal * angle.tan();
+            assert!(
+                (x - expected).abs() <= 0.1 && (y - cy).abs() <= 0.1,
+                "d = {d} m, eye {e}: at ({x:.3}, {y:.3}), expected ({expected:.3}, {cy:.3})"
+            );
+            xs[e] = x;
+        }
+        let disparity = xs[0] - xs[1];
+        let exact = 2.0 * focal * ((b / d).atan() - (b / fixation_m).atan()).tan();
+        let small_angle = 2.0 * b * focal * (1.0 / d - 1.0 / fixation_m);
+        assert!(
+            (disparity - exact).abs() <= 0.1,
+            "d = {d} m: disparity {disparity:.3} px, exact {exact:.3} px (small-angle {small_angle:.3})"
+        );
+        if d == fixation_m {
+            assert!(
+                disparity.abs() <= 0.1,
+                "the fixated point is not centred: {disparity}"
+            );
+        }
+    }
+    // A control: parallel eyes (fixation at infinity) do not centre the point at 2 m.
+    let scene = marker_scene(fixation_m);
+    let mut state = scene.at_time(0.0);
+    let parallel = eye_cameras(&state.camera, 2.0 * b, None);
+    state.camera = parallel[0];
+    let frame = raster.render(&ctx, &state, SIZE.0, SIZE.1).unwrap();
+    let (x, _) = centroid(&frame.color, SIZE.0);
+    assert!(
+        (x - cx).abs() > 5.0,
+        "parallel eyes centred the point at {x}"
+    );
+    drop(raster);
+    finish(ctx);
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = ocular_run(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn a_monovision_pair_shares_one_accommodation() {
+    let dir = temp_dir("monovision");
+    let cache = module_cache();
+    let cache = cache.to_str().unwrap();
+    // The left eye emmetropic, the right myopic by 1.5 D: the same eye behind a +1.5 D contact
+    // lens would be the textbook fit; here two eyes estimated from prescriptions.
+    let near_eye = dir.join("near.toml");
+    let out = ocular_run(&[
+        "eye",
+        "estimate",
+        "--rx",
+        "-1.5",
+        "--pupil-mm",
+        "4",
+        "-o",
+        near_eye.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let output = dir.join("view.png");
+    let run = |focus_m: &str| {
+        json(&[
+            "render",
+            "--scene",
+            "chart",
+            "--size",
+            "64x36",
+            "--eye",
+            "healthy",
+            "--eye-right",
+            near_eye.to_str().unwrap(),
+            "--age",
+            "55",
+            "--pupil-mm",
+            "3",
+            "--focus-m",
+            focus_m,
+            "--quality",
+            "fast",
+            "--cache",
+            cache,
+            "-o",
+            output.to_str().unwrap(),
+            "--json",
+        ])
+    };
+    let far = run("6");
+    let near = run("0.4");
+    let eyes = |v: &serde_json::Value| {
+        let e = v["eyes"].as_array().unwrap();
+        [0, 1].map(|k| {
+            (
+                e[k]["far_point_d"].as_f64().unwrap(),
+                e[k]["residual_defocus_d"].as_f64().unwrap(),
+            )
+        })
+    };
+    let [(fp_l, far_l), (fp_r, far_r)] = eyes(&far);
+    assert!(
+        fp_r - fp_l > 1.2,
+        "far points {fp_l} and {fp_r}: the right eye should be myopic"
+    );
+    // Far: the left eye drives and sees the far chart sharp (within the healthy eye's own
+    // slight myopia: its far point is about 0.2 D); the right keeps its myopia.
+    assert_eq!(far["driver"], "left", "{far}");
+    assert!(
+        far_l.abs() < 0.1 && far_r < -1.2,
+        "residuals {far_l}, {far_r}"
+    );
+    // Near, at 55 (Hofstetter: 2 D of accommodation, short of the 2.5 D the left eye needs):
+    // the right eye drives, the left blurs.
+    let [(_, near_l), (_, near_r)] = eyes(&near);
+    assert_eq!(near["driver"], "right", "{near}");
+    assert!(
+        near_r.abs() < 0.02 && near_l > 1.0,
+        "residuals {near_l}, {near_r}"
+    );
+    for side in ["left", "right"] {
+        assert!(dir.join(format!("view-{side}.png")).exists());
+    }
+}
+
+#[test]
+fn binocular_options_are_checked() {
+    let cases: [(&[&str], &str); 4] = [
+        (&["render", "--ipd-mm", "63"], "--binocular"),
+        (&["render", "--binocular", "--ipd-mm", "20"], "--ipd-mm"),
+        (
+            &["render", "--binocular", "--color", "x.exr", "--fov-y", "40"],
+            "--color",
+        ),
+        (
+            &["render", "--binocular", "--method", "reference"],
+            "--method splat",
+        ),
+    ];
+    for (args, expected) in cases {
+        let out = ocular_run(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(expected) && err.lines().count() == 1,
+            "{args:?}: {err}"
+        );
+    }
+}
