@@ -12,12 +12,11 @@ use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
-use crate::render::binocular::{self, Yoke, SIDES};
-use crate::render::focus::effective_focus;
+use crate::render::binocular::{self, PairRequest, Yoke, SIDES};
 use crate::render::frame::Method;
-use crate::render::frame_plan::{Correction, FocusAsked};
-use crate::render::live::{self, LiveOptions, LiveRenderer, SceneArg};
-use crate::scene::{Camera, Scene};
+use crate::render::frame_plan::Correction;
+use crate::render::live::{LiveOptions, LiveRenderer};
+use crate::scene::Scene;
 use crate::{Error, Result};
 
 /// How a binocular pair is written.
@@ -86,41 +85,6 @@ pub fn eye_output(output: &Path, side: &str) -> PathBuf {
         .map(|e| e.to_string_lossy().to_string())
         .unwrap_or_else(|| "png".into());
     output.with_file_name(format!("{stem}-{side}.{ext}"))
-}
-
-/// Where the eyes look: the point of the focus asked, along its pixel's ray (`--focus-at`) or
-/// straight ahead; None at infinity. Returns the point and the words naming it.
-fn fixation(
-    camera: &Camera,
-    frame: &crate::render::frame::HostFrame,
-    asked: Option<FocusAsked>,
-) -> Result<(Option<[f64; 3]>, String)> {
-    let (vergence_d, from) = frame.focus_d(asked)?;
-    if vergence_d <= 0.0 {
-        return Ok((None, from));
-    }
-    let distance_m = 1.0 / vergence_d;
-    let f = camera.forward();
-    let direction = match asked {
-        Some(FocusAsked::AtPixel(x, y)) => {
-            let yaw = camera.yaw_deg.to_radians();
-            let r = [yaw.cos(), 0.0, -yaw.sin()];
-            let u = [
-                r[1] * f[2] - r[2] * f[1],
-                r[2] * f[0] - r[0] * f[2],
-                r[0] * f[1] - r[1] * f[0],
-            ];
-            let focal = camera.focal_length_px(frame.height);
-            let tx = (f64::from(x) + 0.5 - 0.5 * f64::from(frame.width)) / focal;
-            let ty = (0.5 * f64::from(frame.height) - f64::from(y) - 0.5) / focal;
-            let d = [0, 1, 2].map(|k| f[k] + tx * r[k] + ty * u[k]);
-            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            d.map(|c| c / n)
-        }
-        _ => f,
-    };
-    let p = [0, 1, 2].map(|k| camera.position_m[k] + distance_m * direction[k]);
-    Ok((Some(p), from))
 }
 
 /// One eye's result.
@@ -202,77 +166,46 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     let ctx = Context::new(&cli.context_options())?;
     let live = LiveRenderer::new(ctx, args.cache.dir(), 2);
-    let state = scene.at_time(args.time);
-    let camera = state.camera;
     let size = args
         .size
         .unwrap_or((scene.resolution[0], scene.resolution[1]));
-    // The cyclopean frame: where the eyes look, the pupil both share, the exposure both show.
-    let (centre, warnings) =
-        live.scene_frame(SceneArg::Loaded(&scene), None, Some(size), args.time)?;
-    for w in &warnings {
+    let pair = binocular::render_pair(
+        &live,
+        &PairRequest {
+            scene: &scene,
+            eyes: [&eyes[0], &eyes[1]],
+            options: LiveOptions {
+                focus: super::render::focus_asked(args)?,
+                ..base
+            },
+            size,
+            time_s: args.time,
+            ipd_m: ipd_mm * 1e-3,
+        },
+    )?;
+    for w in &pair.warnings {
         eprintln!("warning: {w}");
     }
-    let (fixation_m, fixation_from) =
-        fixation(&camera, &centre, super::render::focus_asked(args)?)?;
-    let (pupil_mm, pupil_source) = live::pupil_diameter(&base, &centre)?;
-    let exposure_ev = args
-        .exposure
-        .unwrap_or_else(|| Tonemap::auto_exposure_ev_of(&centre.color));
-    let positions = binocular::eye_positions(&camera, ipd_mm * 1e-3);
-    let cameras = binocular::eye_cameras(&camera, ipd_mm * 1e-3, fixation_m);
-    let demand = binocular::demands_d(&positions, fixation_m);
-    let settings = crate::psf::axes::KernelSettings::default();
-    let mut far_point = [0.0; 2];
-    let mut amplitude = [None; 2];
-    let mut corrections = [None, None];
-    for e in 0..2 {
-        let (corrected, physiology) = live::physiology(&eyes[e], &base)?;
-        far_point[e] =
-            effective_focus(&corrected, 0.0, pupil_mm, &settings, "the far point")?.actual_d;
-        amplitude[e] = physiology.accommodation_max_d;
-        corrections[e] = physiology.correction;
-    }
-    let yoke = binocular::yoke(demand, far_point, amplitude);
-    let mut frames = Vec::new();
-    let mut summaries = Vec::new();
-    for e in 0..2 {
-        let o = LiveOptions {
-            focus: Some(FocusAsked::Dioptres(yoke.focus_d[e])),
-            pupil_mm: Some(pupil_mm),
-            luminance_cdm2: None,
-            exposure_ev: Some(f64::from(exposure_ev)),
-            ..base.clone()
-        };
-        let (frame, _) = live.render_scene_from(
-            SceneArg::Loaded(&scene),
-            &eyes[e],
-            &o,
-            Some(size),
-            args.time,
-            Some(cameras[e]),
-        )?;
-        for w in &frame.report.warnings {
-            eprintln!("warning: {} eye: {w}", SIDES[e]);
-        }
-        summaries.push(EyeSummary {
+    let mut summaries: Vec<EyeSummary> = (0..2)
+        .map(|e| EyeSummary {
             side: SIDES[e],
             eye: specs[e].clone(),
             output: None,
-            position_m: positions[e],
-            yaw_deg: cameras[e].yaw_deg,
-            pitch_deg: cameras[e].pitch_deg,
-            demand_d: demand[e],
-            far_point_d: far_point[e],
-            accommodation_max_d: amplitude[e],
-            focus_d: frame.report.focus.actual_d,
-            residual_defocus_d: yoke.residual_d[e],
-            correction: corrections[e].clone(),
-            seconds_render: frame.report.seconds_render,
-            seconds_kernels: frame.report.seconds_kernels,
-        });
-        frames.push(frame.color);
-    }
+            position_m: pair.positions_m[e],
+            yaw_deg: pair.cameras[e].yaw_deg,
+            pitch_deg: pair.cameras[e].pitch_deg,
+            demand_d: pair.demand_d[e],
+            far_point_d: pair.far_point_d[e],
+            accommodation_max_d: pair.amplitude_d[e],
+            focus_d: pair.frames[e].report.focus.actual_d,
+            residual_defocus_d: pair.yoke.residual_d[e],
+            correction: pair.corrections[e].clone(),
+            seconds_render: pair.frames[e].report.seconds_render,
+            seconds_kernels: pair.frames[e].report.seconds_kernels,
+        })
+        .collect();
+    let frames = [&pair.frames[0].color, &pair.frames[1].color];
+    let (exposure_ev, cameras, yoke) = (pair.exposure_ev, pair.cameras, pair.yoke);
     let stereo = args.stereo.unwrap_or(StereoOutput::Separate);
     let outputs = write(args, stereo, size, &frames, exposure_ev)?;
     if stereo == StereoOutput::Separate {
@@ -290,11 +223,11 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         width: size.0,
         height: size.1,
         ipd_mm,
-        fixation_m,
-        fixation_from,
+        fixation_m: pair.fixation_m,
+        fixation_from: pair.fixation_from,
         vergence_deg: cos.acos().to_degrees(),
-        pupil_mm,
-        pupil_source,
+        pupil_mm: pair.pupil_mm,
+        pupil_source: pair.pupil_from,
         yoke,
         driver: SIDES[yoke.driver],
         stereo: match stereo {
@@ -367,7 +300,7 @@ fn write(
     args: &RenderArgs,
     stereo: StereoOutput,
     (w, h): (u32, u32),
-    frames: &[Vec<[f32; 4]>],
+    frames: &[&Vec<[f32; 4]>; 2],
     exposure_ev: f32,
 ) -> Result<Vec<String>> {
     let exr = args
@@ -397,7 +330,7 @@ fn write(
         StereoOutput::SideBySide => {
             let mut pixels = Vec::with_capacity(2 * frames[0].len());
             for row in 0..h as usize {
-                for f in frames {
+                for f in frames.iter() {
                     pixels.extend_from_slice(&f[row * w as usize..(row + 1) * w as usize]);
                 }
             }
@@ -406,7 +339,7 @@ fn write(
         StereoOutput::Anaglyph => {
             let pixels = frames[0]
                 .iter()
-                .zip(&frames[1])
+                .zip(frames[1].iter())
                 .map(|(l, r)| [l[0], r[1], r[2], 1.0])
                 .collect();
             vec![(args.output.clone(), ImageRgba::new(w, h, pixels))]

@@ -12,7 +12,15 @@
 //!   that leaves ([`yoke`]). This is why monovision works: the distance eye drives for far
 //!   targets, the near eye for near ones, and each image stays blurred in the other eye.
 
-use crate::scene::Camera;
+use std::sync::Arc;
+
+use crate::eye::Eye;
+use crate::render::focus::effective_focus;
+use crate::render::frame::HostFrame;
+use crate::render::frame_plan::FocusAsked;
+use crate::render::live::{self, LiveFrame, LiveOptions, LiveRenderer, SceneArg};
+use crate::scene::{Camera, Scene};
+use crate::Result;
 
 /// The adult mean interpupillary distance, in millimetres: 63 mm (Dodgson, "Variation and
 /// extrema of human interpupillary distance", Proc. SPIE 5291, 2004: mean 63.4 mm for adult
@@ -125,6 +133,155 @@ pub fn yoke(demand_d: [f64; 2], far_point_d: [f64; 2], amplitude_d: [Option<f64>
         focus_d,
         residual_d: [0, 1].map(|e| demand_d[e] - focus_d[e]),
     }
+}
+
+/// Where the eyes look: the point of the focus asked, along its pixel's ray (`--focus-at`) or
+/// straight ahead, measured on the camera's own `frame`; None at infinity. Returns the point
+/// and the words naming it.
+pub fn fixation(
+    camera: &Camera,
+    frame: &HostFrame,
+    asked: Option<FocusAsked>,
+) -> Result<(Option<[f64; 3]>, String)> {
+    let (vergence_d, from) = frame.focus_d(asked)?;
+    if vergence_d <= 0.0 {
+        return Ok((None, from));
+    }
+    let f = camera.forward();
+    let direction = match asked {
+        Some(FocusAsked::AtPixel(x, y)) => {
+            let r = right_vector(camera);
+            let u = [
+                r[1] * f[2] - r[2] * f[1],
+                r[2] * f[0] - r[0] * f[2],
+                r[0] * f[1] - r[1] * f[0],
+            ];
+            let focal = camera.focal_length_px(frame.height);
+            let tx = (f64::from(x) + 0.5 - 0.5 * f64::from(frame.width)) / focal;
+            let ty = (0.5 * f64::from(frame.height) - f64::from(y) - 0.5) / focal;
+            let d = [0, 1, 2].map(|k| f[k] + tx * r[k] + ty * u[k]);
+            let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            d.map(|c| c / n)
+        }
+        _ => f,
+    };
+    let distance_m = 1.0 / vergence_d;
+    let p = [0, 1, 2].map(|k| camera.position_m[k] + distance_m * direction[k]);
+    Ok((Some(p), from))
+}
+
+/// A scene to render through two eyes.
+pub struct PairRequest<'a> {
+    pub scene: &'a Arc<Scene>,
+    /// Left, right.
+    pub eyes: [&'a Eye; 2],
+    /// What both share: the focus asked (the fixation), pupil, age, quality, correction.
+    pub options: LiveOptions,
+    pub size: (u32, u32),
+    pub time_s: f64,
+    pub ipd_m: f64,
+}
+
+/// Two frames and how they were made.
+pub struct Pair {
+    pub frames: [LiveFrame; 2],
+    pub positions_m: [[f64; 3]; 2],
+    pub cameras: [Camera; 2],
+    pub fixation_m: Option<[f64; 3]>,
+    pub fixation_from: String,
+    pub demand_d: [f64; 2],
+    pub far_point_d: [f64; 2],
+    pub amplitude_d: [Option<f64>; 2],
+    /// Each eye's correction in `--correct` form.
+    pub corrections: [Option<String>; 2],
+    pub yoke: Yoke,
+    pub pupil_mm: f64,
+    pub pupil_from: String,
+    /// The exposure both frames are shown at: the camera frame's.
+    pub exposure_ev: f32,
+    pub warnings: Vec<String>,
+}
+
+/// Each eye's far point (D) and amplitude of accommodation, with the options' correction and
+/// age, at `pupil_mm`.
+fn eye_limits(
+    eye: &Eye,
+    o: &LiveOptions,
+    pupil_mm: f64,
+) -> Result<(f64, Option<f64>, Option<String>)> {
+    let (corrected, physiology) = live::physiology(eye, o)?;
+    let settings = crate::psf::axes::KernelSettings::default();
+    let far = effective_focus(&corrected, 0.0, pupil_mm, &settings, "the far point")?.actual_d;
+    Ok((far, physiology.accommodation_max_d, physiology.correction))
+}
+
+/// Renders `r` through both eyes: the fixation and the shared pupil and exposure from the
+/// camera's own frame, the eyes converged on the fixation, one accommodation ([`yoke`]).
+pub fn render_pair(live: &LiveRenderer, r: &PairRequest<'_>) -> Result<Pair> {
+    let scene = SceneArg::Loaded(r.scene);
+    let camera = r.scene.at_time(r.time_s).camera;
+    let (centre, mut warnings) = live.scene_frame(scene, None, Some(r.size), r.time_s)?;
+    let (fixation_m, fixation_from) = fixation(&camera, &centre, r.options.focus)?;
+    // One pupil for both (the consensual reflex), from the light the camera sees.
+    let (pupil_mm, pupil_from) = live::pupil_diameter(&r.options, &centre)?;
+    let exposure_ev = r.options.exposure_ev.map_or_else(
+        || crate::image_io::Tonemap::auto_exposure_ev_of(&centre.color),
+        |ev| ev as f32,
+    );
+    let positions_m = eye_positions(&camera, r.ipd_m);
+    let cameras = eye_cameras(&camera, r.ipd_m, fixation_m);
+    let demand_d = demands_d(&positions_m, fixation_m);
+    let limits = [
+        eye_limits(r.eyes[0], &r.options, pupil_mm)?,
+        eye_limits(r.eyes[1], &r.options, pupil_mm)?,
+    ];
+    let far_point_d = [limits[0].0, limits[1].0];
+    let amplitude_d = [limits[0].1, limits[1].1];
+    let yoke = yoke(demand_d, far_point_d, amplitude_d);
+    let render = |e: usize| -> Result<LiveFrame> {
+        let o = LiveOptions {
+            focus: Some(FocusAsked::Dioptres(yoke.focus_d[e])),
+            pupil_mm: Some(pupil_mm),
+            luminance_cdm2: None,
+            exposure_ev: Some(f64::from(exposure_ev)),
+            ..r.options.clone()
+        };
+        let (frame, _) = live.render_scene_from(
+            scene,
+            r.eyes[e],
+            &o,
+            Some(r.size),
+            r.time_s,
+            Some(cameras[e]),
+        )?;
+        Ok(frame)
+    };
+    let frames = [render(0)?, render(1)?];
+    for (e, f) in frames.iter().enumerate() {
+        warnings.extend(
+            f.report
+                .warnings
+                .iter()
+                .map(|w| format!("{} eye: {w}", SIDES[e])),
+        );
+    }
+    let [l0, l1] = limits;
+    Ok(Pair {
+        frames,
+        positions_m,
+        cameras,
+        fixation_m,
+        fixation_from,
+        demand_d,
+        far_point_d,
+        amplitude_d,
+        corrections: [l0.2, l1.2],
+        yoke,
+        pupil_mm,
+        pupil_from,
+        exposure_ev,
+        warnings,
+    })
 }
 
 #[cfg(test)]

@@ -185,10 +185,11 @@ struct Inner {
 /// Renders frames and scenes as eyes see them on one device, keeping the kernels of the
 /// `kept_states` most recent eye states.
 pub struct LiveRenderer {
+    // Declared (and so dropped) before the device its GPU objects belong to.
+    inner: Mutex<Inner>,
     ctx: Context,
     cache_dir: Option<PathBuf>,
     kept_states: usize,
-    inner: Mutex<Inner>,
 }
 
 /// The eye as the CLI renders it: `correction` applied and its accommodation limited by `age`
@@ -229,6 +230,13 @@ impl LiveRenderer {
 
     pub fn context(&self) -> &Context {
         &self.ctx
+    }
+
+    /// The device, once everything made on it is gone (a test checks its validation log).
+    pub fn into_context(self) -> Context {
+        let LiveRenderer { inner, ctx, .. } = self;
+        drop(inner);
+        ctx
     }
 
     /// The device's name and driver.

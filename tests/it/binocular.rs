@@ -246,3 +246,176 @@ fn binocular_options_are_checked() {
         );
     }
 }
+
+/// An E on its card `d_m` ahead on the midline, before a wall, in a narrow field so that a
+/// dioptre of defocus spans pixels.
+fn letter_scene(d_m: f64) -> std::sync::Arc<Scene> {
+    let text = format!(
+        r#"
+name = "letter"
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+fov_y_deg = 10.0
+near_m = 0.05
+far_m = 50.0
+resolution = [192, 108]
+[background]
+color = [0.8, 0.8, 0.8]
+luminance_cd_m2 = 40.0
+[[light]]
+kind = "ambient"
+illuminance_lux = 400.0
+[[object]]
+kind = "optotype"
+letter = "E"
+direction = "right"
+logmar = 1.3
+translate = [0.0, 0.0, {z}]
+[[object]]
+kind = "plane"
+size_m = [20.0, 12.0]
+translate = [0.0, 0.0, -10.0]
+color = [0.35, 0.33, 0.3]
+"#,
+        z = -d_m
+    );
+    std::sync::Arc::new(Scene::from_toml(&text, "letter", std::path::Path::new(".")).unwrap())
+}
+
+/// PSNR (dB, peak 1 after the exposure) of `a` against `b` over columns [x0, x1) of a
+/// 192-wide frame, the middle third of its rows (where the letter is).
+fn region_psnr(a: &[[f32; 4]], b: &[[f32; 4]], (x0, x1): (usize, usize), scale: f32) -> f64 {
+    let (w, h) = (192usize, 108usize);
+    let (mut se, mut n) = (0.0f64, 0usize);
+    for y in h / 3..2 * h / 3 {
+        for x in x0..x1 {
+            let (p, q) = (a[y * w + x], b[y * w + x]);
+            for c in 0..3 {
+                let d = f64::from(((p[c] - q[c]) * scale).clamp(-1.0, 1.0));
+                se += d * d;
+                n += 1;
+            }
+        }
+    }
+    10.0 * (n as f64 / se.max(1e-20)).log10()
+}
+
+#[test]
+fn monovision_frames_are_sharp_where_each_eye_drives_and_independent_eyes_would_differ() {
+    use ocular::render::binocular::{render_pair, PairRequest};
+    use ocular::render::frame_plan::FocusAsked;
+    use ocular::render::live::{LiveOptions, LiveRenderer, SceneArg};
+
+    let dir = temp_dir("monovision-frames");
+    let near_file = dir.join("near.toml");
+    let out = ocular_run(&[
+        "eye",
+        "estimate",
+        "--rx",
+        "-1.5",
+        "--pupil-mm",
+        "4",
+        "-o",
+        near_file.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let near_eye = ocular::eye::load(&near_file).unwrap().eye;
+    let far_eye = ocular::eye::Eye::preset("healthy").unwrap();
+    let live = LiveRenderer::new(gpu(), Some(module_cache()), 4);
+    let mut raster = Rasterizer::new(live.context()).unwrap();
+    let options = |focus_m: f64| LiveOptions {
+        focus: Some(FocusAsked::DistanceM(focus_m)),
+        pupil_mm: Some(5.0),
+        age: 55.0,
+        ..LiveOptions::default()
+    };
+    // The fixated letter is centred in both eyes' frames: its card spans these columns.
+    let letter = (72, 120);
+    for (focus_m, sharp_eye) in [(6.0, 0), (0.4, 1)] {
+        let scene = letter_scene(focus_m);
+        let pair = render_pair(
+            &live,
+            &PairRequest {
+                scene: &scene,
+                eyes: [&far_eye, &near_eye],
+                options: options(focus_m),
+                size: (192, 108),
+                time_s: 0.0,
+                ipd_m: 0.063,
+            },
+        )
+        .unwrap();
+        assert_eq!(pair.yoke.driver, sharp_eye, "at {focus_m} m");
+        let scale = 2f32.powf(pair.exposure_ev);
+        // Each eye against the sharp frame from its own position: the driving eye's letter is
+        // near it, the other's is not.
+        let quality = [0, 1].map(|e| {
+            let mut state = scene.at_time(0.0);
+            state.camera = pair.cameras[e];
+            let sharp = raster.render(live.context(), &state, 192, 108).unwrap();
+            region_psnr(&pair.frames[e].color, &sharp.color, letter, scale)
+        });
+        let other = 1 - sharp_eye;
+        assert!(
+            quality[sharp_eye] > quality[other] + 6.0,
+            "at {focus_m} m the {} eye should see the letter sharper: {quality:?} dB",
+            ["left", "right"][sharp_eye]
+        );
+        // The other eye's frame is the single-eye render of its yoked state …
+        let single = |focus_d: f64| {
+            let o = LiveOptions {
+                focus: Some(FocusAsked::Dioptres(focus_d)),
+                exposure_ev: Some(f64::from(pair.exposure_ev)),
+                ..options(focus_m)
+            };
+            let eye = [&far_eye, &near_eye][other];
+            let (f, _) = live
+                .render_scene_from(
+                    SceneArg::Loaded(&scene),
+                    eye,
+                    &o,
+                    Some((192, 108)),
+                    0.0,
+                    Some(pair.cameras[other]),
+                )
+                .unwrap();
+            f.color
+        };
+        let yoked = single(pair.yoke.focus_d[other]);
+        let same = region_psnr(&pair.frames[other].color, &yoked, (0, 192), scale);
+        assert!(
+            same > 60.0,
+            "the pair's frame is not its eye state's: {same:.1} dB"
+        );
+        // … and, near, not what that eye would see accommodating alone (the negative control:
+        // the left eye alone would spend its 2 D on the card). Far, both models agree: the
+        // myopic eye is relaxed either way.
+        let demand = pair.demand_d[other];
+        let amplitude = pair.amplitude_d[other].unwrap_or(f64::INFINITY);
+        let alone_d = demand.clamp(pair.far_point_d[other], pair.far_point_d[other] + amplitude);
+        let alone = single(alone_d);
+        let differs = region_psnr(&pair.frames[other].color, &alone, letter, scale);
+        if sharp_eye == 1 {
+            assert!(
+                (alone_d - pair.yoke.focus_d[other]).abs() > 0.5 && differs < 30.0,
+                "accommodating alone ({alone_d:.2} D vs {:.2} D) looks the same: {differs:.1} dB",
+                pair.yoke.focus_d[other]
+            );
+            eprintln!(
+                "near: left eye yoked {:.2} D vs alone {alone_d:.2} D: {differs:.1} dB apart; \
+                 letter vs sharp {quality:?} dB",
+                pair.yoke.focus_d[other]
+            );
+        } else {
+            assert!((alone_d - pair.yoke.focus_d[other]).abs() < 1e-9);
+            eprintln!("far: letter vs sharp {quality:?} dB");
+        }
+    }
+    drop(raster);
+    finish(live.into_context());
+}
