@@ -42,6 +42,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
         let stray = [
             ("--ipd-mm", args.ipd_mm.is_some()),
             ("--stereo", args.stereo.is_some()),
+            ("--correct-right", args.correct_right.is_some()),
         ];
         if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
             return Err(Error::input(format!(
@@ -176,8 +177,15 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             eyes: [&eyes[0], &eyes[1]],
             options: LiveOptions {
                 focus: super::render::focus_asked(args)?,
-                ..base
+                ..base.clone()
             },
+            corrections: [
+                base.correction.clone(),
+                Correction {
+                    spectacle: args.correct_right.or(base.correction.spectacle),
+                    ..base.correction.clone()
+                },
+            ],
             size,
             time_s: args.time,
             ipd_m: ipd_mm * 1e-3,

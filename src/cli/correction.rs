@@ -53,7 +53,7 @@ fn range(v: f64, (lo, hi): (f64, f64), unit: &str) -> std::result::Result<f64, S
     }
 }
 
-fn parse_correct(text: &str) -> std::result::Result<Spectacle, String> {
+pub(super) fn parse_correct(text: &str) -> std::result::Result<Spectacle, String> {
     parse_rx(text, DEFAULT_VERTEX_MM)
 }
 

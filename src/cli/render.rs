@@ -83,6 +83,10 @@ pub struct RenderArgs {
     /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
     #[arg(long, value_name = "NAME|FILE")]
     pub eye_right: Option<String>,
+    /// The right eye's own spectacle or contact lens, "S C x A" (as --correct, whose
+    /// --vertex-mm and --correct-contact it shares); --correct is then the left eye's.
+    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
+    pub correct_right: Option<crate::eye::correction::Spectacle>,
     /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub ipd_mm: Option<f64>,

@@ -17,7 +17,7 @@ use std::sync::Arc;
 use crate::eye::Eye;
 use crate::render::focus::effective_focus;
 use crate::render::frame::HostFrame;
-use crate::render::frame_plan::FocusAsked;
+use crate::render::frame_plan::{Correction, FocusAsked};
 use crate::render::live::{self, LiveFrame, LiveOptions, LiveRenderer, SceneArg};
 use crate::scene::{Camera, Scene};
 use crate::Result;
@@ -175,8 +175,11 @@ pub struct PairRequest<'a> {
     pub scene: &'a Arc<Scene>,
     /// Left, right.
     pub eyes: [&'a Eye; 2],
-    /// What both share: the focus asked (the fixation), pupil, age, quality, correction.
+    /// What both share: the focus asked (the fixation), pupil, age, quality (its correction
+    /// is replaced by each eye's own).
     pub options: LiveOptions,
+    /// Each eye's spectacle, contact lens or IOL (left, right).
+    pub corrections: [Correction; 2],
     pub size: (u32, u32),
     pub time_s: f64,
     pub ipd_m: f64,
@@ -231,9 +234,13 @@ pub fn render_pair(live: &LiveRenderer, r: &PairRequest<'_>) -> Result<Pair> {
     let positions_m = eye_positions(&camera, r.ipd_m);
     let cameras = eye_cameras(&camera, r.ipd_m, fixation_m);
     let demand_d = demands_d(&positions_m, fixation_m);
+    let options = [0, 1].map(|e| LiveOptions {
+        correction: r.corrections[e].clone(),
+        ..r.options.clone()
+    });
     let limits = [
-        eye_limits(r.eyes[0], &r.options, pupil_mm)?,
-        eye_limits(r.eyes[1], &r.options, pupil_mm)?,
+        eye_limits(r.eyes[0], &options[0], pupil_mm)?,
+        eye_limits(r.eyes[1], &options[1], pupil_mm)?,
     ];
     let far_point_d = [limits[0].0, limits[1].0];
     let amplitude_d = [limits[0].1, limits[1].1];
@@ -244,7 +251,7 @@ pub fn render_pair(live: &LiveRenderer, r: &PairRequest<'_>) -> Result<Pair> {
             pupil_mm: Some(pupil_mm),
             luminance_cdm2: None,
             exposure_ev: Some(f64::from(exposure_ev)),
-            ..r.options.clone()
+            ..options[e].clone()
         };
         let (frame, _) = live.render_scene_from(
             scene,

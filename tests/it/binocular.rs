@@ -344,6 +344,7 @@ fn monovision_frames_are_sharp_where_each_eye_drives_and_independent_eyes_would_
                 scene: &scene,
                 eyes: [&far_eye, &near_eye],
                 options: options(focus_m),
+                corrections: Default::default(),
                 size: (192, 108),
                 time_s: 0.0,
                 ipd_m: 0.063,
@@ -417,5 +418,154 @@ fn monovision_frames_are_sharp_where_each_eye_drives_and_independent_eyes_would_
         }
     }
     drop(raster);
+    finish(live.into_context());
+}
+
+/// The entrance pupil's depth behind the corneal vertex (mm): the stop at the lens's anterior
+/// vertex imaged backwards through the two corneal surfaces by paraxial vergences, with
+/// Navarro's indices (cornea 1.376, aqueous 1.3374). Navarro's eye gives 3.04 mm.
+fn entrance_pupil_depth_mm(eye: &ocular::eye::Eye) -> f64 {
+    let (n_cornea, n_aqueous) = (1.376, 1.3374);
+    let c = &eye.cornea;
+    // reversed: light leaves the stop towards the cornea; radii change sign
+    let mut vergence = n_aqueous / -eye.aqueous_depth_mm;
+    vergence += (n_cornea - n_aqueous) / -c.posterior.radius_mm[0];
+    vergence /= 1.0 - c.thickness_mm / n_cornea * vergence;
+    vergence += (1.0 - n_cornea) / -c.anterior.radius_mm[0];
+    -1.0 / vergence
+}
+
+#[test]
+fn glasses_of_different_powers_give_each_eye_its_image_size() {
+    use ocular::render::binocular::{render_pair, PairRequest};
+    use ocular::render::frame_plan::Correction;
+    use ocular::render::live::{LiveOptions, LiveRenderer};
+
+    // A bright sphere far away, 5° right of the view: its image lies at f·M·tan θ from the
+    // centre of each (parallel) eye's frame, M the eye's spectacle magnification.
+    let (distance_m, angle_deg): (f64, f64) = (100.0, 5.0);
+    let x_m = distance_m * angle_deg.to_radians().tan();
+    let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
+    let text = format!(
+        r#"
+name = "far marker"
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+fov_y_deg = {FOV_Y_DEG}
+near_m = 0.05
+far_m = 500.0
+resolution = [{w}, {h}]
+[background]
+color = [1.0, 1.0, 1.0]
+luminance_cd_m2 = 0.01
+[[light]]
+kind = "ambient"
+illuminance_lux = 300.0
+[[object]]
+kind = "sphere"
+radius_m = {r}
+segments = 256
+translate = [{x_m}, 0.0, {z}]
+color = [0.8, 0.8, 0.8]
+"#,
+        w = SIZE.0,
+        h = SIZE.1,
+        r = distance_m * 8.0 / focal,
+        z = -distance_m
+    );
+    let scene = std::sync::Arc::new(
+        Scene::from_toml(&text, "far marker", std::path::Path::new(".")).unwrap(),
+    );
+    // An anisometropic pair: a mild and a strong myope, each in glasses of its own power; eyes
+    // estimated from the prescriptions alone have no coma to shift an image's centroid.
+    let powers_d = [-0.25, -6.0];
+    let dir = temp_dir("aniseikonia");
+    let eyes = powers_d.map(|p| {
+        let file = dir.join(format!("eye{p}.toml"));
+        let out = ocular_run(&[
+            "eye",
+            "estimate",
+            "--rx",
+            &format!("{p}"),
+            "--pupil-mm",
+            "4",
+            "-o",
+            file.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        ocular::eye::load(&file).unwrap().eye
+    });
+    let vertex_mm = 12.0;
+    let corrections = powers_d.map(|p| Correction {
+        spectacle: Some(ocular::eye::Spectacle::new(p, 0.0, 180.0, vertex_mm).unwrap()),
+        vertex_mm: Some(vertex_mm),
+        ..Correction::default()
+    });
+    let live = LiveRenderer::new(gpu(), Some(module_cache()), 2);
+    let pair = render_pair(
+        &live,
+        &PairRequest {
+            scene: &scene,
+            eyes: [&eyes[0], &eyes[1]],
+            options: LiveOptions {
+                focus: Some(ocular::render::frame_plan::FocusAsked::DistanceM(
+                    f64::INFINITY,
+                )),
+                pupil_mm: Some(3.0),
+                ..LiveOptions::default()
+            },
+            corrections,
+            size: SIZE,
+            time_s: 0.0,
+            ipd_m: DEFAULT_IPD_MM * 1e-3,
+        },
+    )
+    .unwrap();
+    // Independently: a thin lens at h = vertex + the entrance pupil's depth magnifies tangents
+    // by 1 / (1 − h·P); the depth is the iris (at the lens) imaged back through the cornea.
+    let magnification = [0, 1].map(|e| {
+        let h_m = (vertex_mm + entrance_pupil_depth_mm(&eyes[e])) * 1e-3;
+        1.0 / (1.0 - h_m * powers_d[e])
+    });
+    let cx = 0.5 * f64::from(SIZE.0);
+    let mut offsets = [0.0; 2];
+    for e in 0..2 {
+        let (x, _) = centroid(&pair.frames[e].color, SIZE.0);
+        // each eye sees the marker from its own position (parallax, exact)
+        let tangent = (x_m - pair.positions_m[e][0]) / distance_m;
+        let expected = focal * magnification[e] * tangent;
+        offsets[e] = x - cx;
+        assert!(
+            (offsets[e] / expected - 1.0).abs() < 0.003,
+            "eye {e}: image at {:.3} px from the centre, expected {expected:.3} (M = {:.4})",
+            offsets[e],
+            magnification[e]
+        );
+    }
+    // The two images differ in size by the ratio of the magnifications (4.1 % here).
+    let ratio = offsets[0] / offsets[1];
+    let parallax = (x_m - pair.positions_m[0][0]) / (x_m - pair.positions_m[1][0]);
+    let expected = magnification[0] / magnification[1] * parallax;
+    assert!(
+        (ratio / expected - 1.0).abs() < 0.002,
+        "size ratio {ratio:.5}, expected {expected:.5}"
+    );
+    eprintln!(
+        "aniseikonia: M = {magnification:?}; image offsets {offsets:?} px; size ratio {ratio:.5} \
+         (expected {expected:.5})"
+    );
+    // Without the glasses' magnification (the same eyes uncorrected) the sizes would agree to
+    // the parallax alone: the control fails the bar.
+    assert!((parallax / expected - 1.0).abs() > 0.02);
+    let navarro = entrance_pupil_depth_mm(&ocular::eye::Eye::preset("navarro").unwrap());
+    assert!(
+        (navarro - 3.04).abs() < 0.01,
+        "Navarro's entrance pupil at {navarro} mm"
+    );
     finish(live.into_context());
 }
