@@ -569,3 +569,58 @@ color = [0.8, 0.8, 0.8]
     );
     finish(live.into_context());
 }
+
+#[test]
+fn a_pair_is_written_as_two_files_side_by_side_or_as_an_anaglyph() {
+    let dir = temp_dir("outputs");
+    let cache = module_cache();
+    let run = |stereo: &str, name: &str| {
+        let out = ocular_run(&[
+            "render",
+            "--scene",
+            "primitives",
+            "--size",
+            "64x36",
+            "--binocular",
+            "--eye",
+            "healthy",
+            "--focus-m",
+            "0.5",
+            "--quality",
+            "fast",
+            "--cache",
+            cache.to_str().unwrap(),
+            "--stereo",
+            stereo,
+            "-o",
+            dir.join(name).to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    run("separate", "view.png");
+    run("side-by-side", "sbs.png");
+    run("anaglyph", "red-cyan.png");
+    let load = |name: &str| image::open(dir.join(name)).unwrap().to_rgb8();
+    let (left, right) = (load("view-left.png"), load("view-right.png"));
+    assert_eq!(left.dimensions(), (64, 36));
+    assert_ne!(left, right, "the eyes see from different places");
+    let sbs = load("sbs.png");
+    assert_eq!(sbs.dimensions(), (128, 36));
+    let ana = load("red-cyan.png");
+    for y in 0..36 {
+        for x in 0..64 {
+            assert_eq!(sbs.get_pixel(x, y), left.get_pixel(x, y));
+            assert_eq!(sbs.get_pixel(64 + x, y), right.get_pixel(x, y));
+            let (a, l, r) = (
+                ana.get_pixel(x, y),
+                left.get_pixel(x, y),
+                right.get_pixel(x, y),
+            );
+            assert_eq!([a[0], a[1], a[2]], [l[0], r[1], r[2]], "at {x},{y}");
+        }
+    }
+}
