@@ -24,6 +24,19 @@ use crate::scene::Scene;
 #[pyclass(name = "Renderer", module = "ocular_render")]
 pub struct PyRenderer {
     live: LiveRenderer,
+    last_pair: std::sync::Mutex<Option<PairReport>>,
+}
+
+/// How the last binocular pair was rendered, for `Renderer.last_pair`.
+#[derive(Clone, Copy)]
+struct PairReport {
+    driver: &'static str,
+    accommodation_d: f64,
+    focus_d: [f64; 2],
+    residual_d: [f64; 2],
+    far_point_d: [f64; 2],
+    demand_d: [f64; 2],
+    pupil_mm: f64,
 }
 
 fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
@@ -64,10 +77,11 @@ impl PyRenderer {
         } else {
             None
         };
-        // one eye state kept: a script sweeping a parameter would otherwise hold the GPU
-        // memory of several
+        // two eye states kept (a binocular pair's): a script sweeping a parameter would
+        // otherwise hold the GPU memory of several
         Ok(PyRenderer {
-            live: LiveRenderer::new(ctx, cache_dir, 1),
+            live: LiveRenderer::new(ctx, cache_dir, 2),
+            last_pair: std::sync::Mutex::new(None),
         })
     }
 
@@ -184,6 +198,109 @@ impl PyRenderer {
         warn_all(py, &warnings)?;
         self.warn_last(py)?;
         Ok(rgb_out(py, w, h, &pixels))
+    }
+
+    /// A scene through two eyes (`ocular render --binocular`): `left` and `right` (None: the
+    /// left eye for both) `ipd_mm` apart, converging on the focus point and sharing one
+    /// accommodation and one pupil. Returns (left, right), each (H, W, 3) float32 linear RGB;
+    /// `last_pair` says which eye drove accommodation and each eye's defocus.
+    #[pyo3(signature = (scene, left, right = None, *, ipd_mm = 63.0, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, exposure_ev = None, quality = "balanced"))]
+    #[allow(clippy::too_many_arguments)]
+    fn render_scene_pair<'py>(
+        &self,
+        py: Python<'py>,
+        scene: &str,
+        left: &PyEye,
+        right: Option<&PyEye>,
+        ipd_mm: f64,
+        size: Option<(u32, u32)>,
+        time_s: f64,
+        focus_m: Option<f64>,
+        focus_d: Option<f64>,
+        focus_at: Option<(u32, u32)>,
+        pupil_mm: Option<f64>,
+        luminance_cdm2: Option<f64>,
+        age: f64,
+        exposure_ev: Option<f64>,
+        quality: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = options(
+            focus_m,
+            focus_d,
+            focus_at,
+            pupil_mm,
+            luminance_cdm2,
+            age,
+            "splat",
+            1,
+            false,
+            exposure_ev,
+            quality,
+        )
+        .map_err(super::to_py)?;
+        let (lo, hi) = crate::render::binocular::IPD_RANGE_MM;
+        if !(ipd_mm.is_finite() && (lo..=hi).contains(&ipd_mm)) {
+            return Err(super::value_error(format!(
+                "--ipd-mm {ipd_mm} is outside {lo} to {hi} mm"
+            )));
+        }
+        let eyes = [
+            left.eye.clone(),
+            right.map_or_else(|| left.eye.clone(), |r| r.eye.clone()),
+        ];
+        let scene_name = scene.to_string();
+        let pair = guarded(py, || {
+            let loaded = std::sync::Arc::new(Scene::load(&scene_name)?);
+            let size = size.unwrap_or((loaded.resolution[0], loaded.resolution[1]));
+            crate::render::binocular::render_pair(
+                &self.live,
+                &crate::render::binocular::PairRequest {
+                    scene: &loaded,
+                    eyes: [&eyes[0], &eyes[1]],
+                    options: o.clone(),
+                    corrections: Default::default(),
+                    size,
+                    time_s,
+                    ipd_m: ipd_mm * 1e-3,
+                },
+            )
+        })?;
+        warn_all(py, &pair.warnings)?;
+        let (w, h) = (pair.frames[0].report.width, pair.frames[0].report.height);
+        let report = PairReport {
+            driver: crate::render::binocular::SIDES[pair.yoke.driver],
+            accommodation_d: pair.yoke.accommodation_d,
+            focus_d: pair.yoke.focus_d,
+            residual_d: pair.yoke.residual_d,
+            far_point_d: pair.far_point_d,
+            demand_d: pair.demand_d,
+            pupil_mm: pair.pupil_mm,
+        };
+        *self.last_pair.lock().unwrap_or_else(|p| p.into_inner()) = Some(report);
+        let out = (
+            rgb_out(py, w, h, &pair.frames[0].color),
+            rgb_out(py, w, h, &pair.frames[1].color),
+        );
+        Ok(out.into_pyobject(py)?.into_any())
+    }
+
+    /// How the last pair was rendered (`render_scene_pair`): the eye that drove accommodation
+    /// ("left" or "right"), the shared response, and per eye (left, right) where it focused,
+    /// its far point, its demand and its defocus at the target (D); None before the first.
+    #[getter]
+    fn last_pair<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(r) = *self.last_pair.lock().unwrap_or_else(|p| p.into_inner()) else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        d.set_item("driver", r.driver)?;
+        d.set_item("accommodation_d", r.accommodation_d)?;
+        d.set_item("focus_d", r.focus_d.to_vec())?;
+        d.set_item("residual_d", r.residual_d.to_vec())?;
+        d.set_item("far_point_d", r.far_point_d.to_vec())?;
+        d.set_item("demand_d", r.demand_d.to_vec())?;
+        d.set_item("pupil_mm", r.pupil_mm)?;
+        Ok(Some(d))
     }
 
     /// Rasterises a scene: (color (H, W, 3) float32 linear RGB, depth (H, W) float32 metres

@@ -265,3 +265,29 @@ def test_the_quality_preset_changes_the_work_and_a_bad_one_is_refused(renderer):
     assert 0 < difference < 0.05, difference
     with pytest.raises(ValueError, match=r'^--quality "fastest" is not one of exact, balanced, fast$'):
         renderer.render(eye, color, depth, quality="fastest", **args)
+
+
+def test_a_binocular_pair_equals_the_cli_pair(tmp_path, cli, kernel_cache):
+    r = oc.Renderer(cache_dir=kernel_cache)
+    left, right = r.render_scene_pair(
+        "primitives", oc.Eye.preset("healthy"), oc.Eye.preset("myopia"), size=(64, 36),
+        focus_m=0.5, pupil_mm=3.0, age=55, quality="fast")
+    assert left.shape == right.shape == (36, 64, 3)
+    out = tmp_path / "pair.exr"
+    subprocess.run(
+        [cli, "render", "--scene", "primitives", "--size", "64x36", "--eye", "healthy",
+         "--eye-right", "myopia", "--focus-m", "0.5", "--pupil-mm", "3", "--age", "55",
+         "--quality", "fast", "--cache", str(kernel_cache), "-o", str(out)],
+        check=True, capture_output=True)
+    for ours, side in ((left, "left"), (right, "right")):
+        theirs = oc.read_exr(tmp_path / f"pair-{side}.exr")[..., :3]
+        scale = float(np.abs(theirs).max())
+        assert np.abs(ours - theirs).max() <= 1e-6 * scale, side
+    pair = r.last_pair
+    # the healthy eye reaches 2 D with the least accommodation; the -6 D myope's far point is
+    # nearer than 0.5 m, so it stays relaxed and keeps a negative defocus
+    assert pair["driver"] == "left"
+    assert abs(pair["residual_d"][0]) < 0.05 and pair["residual_d"][1] < -3.0
+    assert not np.allclose(left, right)
+    with pytest.raises(ValueError, match="--ipd-mm"):
+        r.render_scene_pair("primitives", oc.Eye.preset("healthy"), ipd_mm=10.0)
