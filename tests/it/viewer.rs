@@ -315,8 +315,10 @@ fn the_rate_and_the_number_of_clients_are_bounded() {
         .filter(|r| r.contains("too many messages"))
         .count();
     assert_eq!(pongs + limited, 100);
+    // A burst of 60 and 30 a second after it: about 60 answered when the 100 arrive at once,
+    // more on a slow machine that takes a while to read them; all 100 without the bound.
     assert!(
-        (55..=75).contains(&pongs) && limited >= 25,
+        (55..=90).contains(&pongs) && limited >= 10,
         "{pongs} answered, {limited} limited"
     );
 }
