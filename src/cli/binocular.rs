@@ -11,7 +11,7 @@ use super::render::RenderArgs;
 use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::image_io::{self, ImageRgba, Tonemap};
 use crate::render::binocular::{self, PairRequest, Yoke, SIDES};
 use crate::render::frame::Method;
 use crate::render::frame_plan::Correction;
@@ -65,12 +65,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
         ));
     }
     if let Some(ipd) = args.ipd_mm {
-        let (lo, hi) = binocular::IPD_RANGE_MM;
-        if !(ipd.is_finite() && (lo..=hi).contains(&ipd)) {
-            return Err(Error::input(format!(
-                "--ipd-mm {ipd} is outside {lo} to {hi} mm"
-            )));
-        }
+        binocular::check_ipd_mm(ipd).map_err(Error::input)?;
     }
     Ok(())
 }
@@ -147,14 +142,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             args.time
         )));
     }
-    let c = &args.correction;
-    let correction = Correction {
-        spectacle: c.correct,
-        vertex_mm: c.vertex_mm,
-        contact: c.correct_contact,
-        iol: c.iol_d,
-        accommodation_max_d: c.accommodation_max_d,
-    };
+    let correction = args.correction.correction();
     let base = LiveOptions {
         pupil_mm: args.pupil_mm,
         luminance_cdm2: args.luminance_cdm2,
@@ -165,6 +153,15 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         correction,
         ..LiveOptions::default()
     };
+    // Every file of the pair is checked writable before rendering, and kept only if all are
+    // written.
+    let stereo = args.stereo.unwrap_or(StereoOutput::Separate);
+    let paths = output_paths(args, stereo);
+    let mut files = super::outputs::Outputs::new();
+    for p in &paths {
+        files.add("-o", p, &[])?;
+    }
+    files.probe()?;
     let ctx = Context::new(&cli.context_options())?;
     let live = LiveRenderer::new(ctx, args.cache.dir(), 2);
     let size = args
@@ -214,8 +211,9 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         .collect();
     let frames = [&pair.frames[0].color, &pair.frames[1].color];
     let (exposure_ev, cameras, yoke) = (pair.exposure_ev, pair.cameras, pair.yoke);
-    let stereo = args.stereo.unwrap_or(StereoOutput::Separate);
-    let outputs = write(args, stereo, size, &frames, exposure_ev)?;
+    write(args, stereo, size, &frames, exposure_ev, (&files, &paths))?;
+    files.commit()?;
+    let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     if stereo == StereoOutput::Separate {
         for (s, o) in summaries.iter_mut().zip(&outputs) {
             s.output = Some(o.clone());
@@ -248,11 +246,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         device: live.device(),
     };
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&summary)
-                .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?
-        );
+        println!("{}", super::eye::json(&summary)?);
         return Ok(());
     }
     print(&summary);
@@ -303,37 +297,42 @@ fn print(s: &Summary) {
     }
 }
 
-/// Writes the pair as asked; returns the files written.
+/// The files a pair is written to: one per eye (`separate`), else `-o`.
+fn output_paths(args: &RenderArgs, stereo: StereoOutput) -> Vec<PathBuf> {
+    match stereo {
+        StereoOutput::Separate => SIDES
+            .iter()
+            .map(|side| eye_output(&args.output, side))
+            .collect(),
+        _ => vec![args.output.clone()],
+    }
+}
+
+/// Writes the pair as asked into the temporaries of `files` (`paths` in order).
 fn write(
     args: &RenderArgs,
     stereo: StereoOutput,
     (w, h): (u32, u32),
     frames: &[&Vec<[f32; 4]>; 2],
     exposure_ev: f32,
-) -> Result<Vec<String>> {
+    (files, paths): (&super::outputs::Outputs, &[PathBuf]),
+) -> Result<()> {
     let exr = args
         .output
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    let mode = match args.tonemap {
-        super::raster::TonemapArg::Clamp => TonemapMode::Clamp,
-        super::raster::TonemapArg::Reinhard => TonemapMode::Reinhard,
-    };
+    let mode = args.tonemap.mode();
     let save = |path: &Path, image: &ImageRgba| {
+        let path = files.temporary(path);
         if exr {
             image_io::write_exr_rgba(path, image)
         } else {
             image_io::write_png(path, image, Tonemap { exposure_ev, mode })
         }
     };
-    let images: Vec<(PathBuf, ImageRgba)> = match stereo {
+    let images: Vec<ImageRgba> = match stereo {
         StereoOutput::Separate => (0..2)
-            .map(|e| {
-                (
-                    eye_output(&args.output, SIDES[e]),
-                    ImageRgba::new(w, h, frames[e].clone()),
-                )
-            })
+            .map(|e| ImageRgba::new(w, h, frames[e].clone()))
             .collect(),
         StereoOutput::SideBySide => {
             let mut pixels = Vec::with_capacity(2 * frames[0].len());
@@ -342,7 +341,7 @@ fn write(
                     pixels.extend_from_slice(&f[row * w as usize..(row + 1) * w as usize]);
                 }
             }
-            vec![(args.output.clone(), ImageRgba::new(2 * w, h, pixels))]
+            vec![ImageRgba::new(2 * w, h, pixels)]
         }
         StereoOutput::Anaglyph => {
             let pixels = frames[0]
@@ -350,13 +349,11 @@ fn write(
                 .zip(frames[1].iter())
                 .map(|(l, r)| [l[0], r[1], r[2], 1.0])
                 .collect();
-            vec![(args.output.clone(), ImageRgba::new(w, h, pixels))]
+            vec![ImageRgba::new(w, h, pixels)]
         }
     };
-    let mut written = Vec::new();
-    for (path, image) in images {
-        save(&path, &image)?;
-        written.push(path.display().to_string());
+    for (path, image) in paths.iter().zip(&images) {
+        save(path, image)?;
     }
-    Ok(written)
+    Ok(())
 }

@@ -3,9 +3,7 @@
 //! range-checked where clap parses it, so a bad one is a one-line error naming the option.
 
 use crate::eye::age::{HofstetterLine, MAX_AMPLITUDE_D};
-use crate::eye::correction::{
-    parse_rx, Spectacle, DEFAULT_VERTEX_MM, IOL_RANGE_D, VERTEX_RANGE_MM,
-};
+use crate::eye::correction::{parse_rx, Spectacle, DEFAULT_VERTEX_MM};
 use crate::eye::Eye;
 use crate::render::frame_plan::{corrected_eye, Correction};
 pub use crate::render::frame_plan::{IolPower, Physiology};
@@ -58,15 +56,11 @@ pub(super) fn parse_correct(text: &str) -> std::result::Result<Spectacle, String
 }
 
 fn parse_vertex_mm(text: &str) -> std::result::Result<f64, String> {
-    range(number(text)?, VERTEX_RANGE_MM, "mm")
+    crate::render::frame_plan::check_vertex_mm(number(text)?)
 }
 
 fn parse_iol(text: &str) -> std::result::Result<IolPower, String> {
-    if text.trim().eq_ignore_ascii_case("auto") {
-        return Ok(IolPower::Auto);
-    }
-    let v = number(text).map_err(|e| format!("{e}; a power in D or auto"))?;
-    range(v, IOL_RANGE_D, "D").map(IolPower::Dioptres)
+    IolPower::parse(text)
 }
 
 pub(crate) fn parse_amplitude_d(text: &str) -> std::result::Result<f64, String> {
@@ -86,14 +80,18 @@ impl CorrectionArgs {
         eye: &Eye,
         age: Option<(f64, HofstetterLine)>,
     ) -> Result<(Eye, Physiology)> {
-        let correction = Correction {
+        corrected_eye(eye, &self.correction(), age)
+    }
+
+    /// The correction these options describe.
+    pub fn correction(&self) -> Correction {
+        Correction {
             spectacle: self.correct,
             vertex_mm: self.vertex_mm,
             contact: self.correct_contact,
             iol: self.iol_d,
             accommodation_max_d: self.accommodation_max_d,
-        };
-        corrected_eye(eye, &correction, age)
+        }
     }
 }
 

@@ -389,7 +389,7 @@ fn run_estimate(a: &EstimateArgs) -> Result<()> {
     Ok(())
 }
 
-fn json<T: serde::Serialize>(v: &T) -> Result<String> {
+pub(super) fn json<T: serde::Serialize>(v: &T) -> Result<String> {
     serde_json::to_string_pretty(v).map_err(|e| Error::input(format!("cannot encode JSON: {e}")))
 }
 

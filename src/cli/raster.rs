@@ -19,6 +19,15 @@ pub enum TonemapArg {
     Reinhard,
 }
 
+impl TonemapArg {
+    pub(super) fn mode(self) -> TonemapMode {
+        match self {
+            TonemapArg::Clamp => TonemapMode::Clamp,
+            TonemapArg::Reinhard => TonemapMode::Reinhard,
+        }
+    }
+}
+
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     ocular raster --scene primitives -o colour.exr --depth-out depth.exr\n  \
@@ -136,10 +145,7 @@ pub fn run(cli: &Cli, args: &RasterArgs) -> Result<()> {
             exposure_ev: args
                 .exposure
                 .unwrap_or_else(|| Tonemap::auto_exposure_ev(&color)),
-            mode: match args.tonemap {
-                TonemapArg::Clamp => TonemapMode::Clamp,
-                TonemapArg::Reinhard => TonemapMode::Reinhard,
-            },
+            mode: args.tonemap.mode(),
         };
         image_io::write_png(outputs.temporary(path), &color, tonemap)?;
         wrote.push(format!(

@@ -1,9 +1,8 @@
 //! `ocular render`'s output: the image file and the summary (text or JSON).
 
-use super::raster::TonemapArg;
 use super::render::{Input, RenderArgs};
 use crate::gpu::Context;
-use crate::image_io::{self, ImageRgba, Tonemap, TonemapMode};
+use crate::image_io::{self, ImageRgba, Tonemap};
 use crate::render::frame::Method;
 use crate::{Error, Result};
 
@@ -155,10 +154,7 @@ fn write_image(
     if output_ext == Some("exr") {
         return image_io::write_exr_rgba(&args.output, &image);
     }
-    let mode = match args.tonemap {
-        TonemapArg::Clamp => TonemapMode::Clamp,
-        TonemapArg::Reinhard => TonemapMode::Reinhard,
-    };
+    let mode = args.tonemap.mode();
     let exposure_ev = exposure_ev(args, input);
     image_io::write_png(&args.output, &image, Tonemap { exposure_ev, mode })
 }

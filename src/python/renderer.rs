@@ -238,19 +238,15 @@ impl PyRenderer {
             quality,
         )
         .map_err(super::to_py)?;
-        let (lo, hi) = crate::render::binocular::IPD_RANGE_MM;
-        if !(ipd_mm.is_finite() && (lo..=hi).contains(&ipd_mm)) {
-            return Err(super::value_error(format!(
-                "--ipd-mm {ipd_mm} is outside {lo} to {hi} mm"
-            )));
-        }
+        crate::render::binocular::check_ipd_mm(ipd_mm).map_err(super::value_error)?;
         let eyes = [
             left.eye.clone(),
             right.map_or_else(|| left.eye.clone(), |r| r.eye.clone()),
         ];
         let scene_name = scene.to_string();
         let pair = guarded(py, || {
-            let loaded = std::sync::Arc::new(Scene::load(&scene_name)?);
+            // the renderer's current scene: loaded once, its frames and geometry kept
+            let loaded = self.live.scene(SceneArg::Name(&scene_name))?;
             let size = size.unwrap_or((loaded.resolution[0], loaded.resolution[1]));
             crate::render::binocular::render_pair(
                 &self.live,

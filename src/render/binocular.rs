@@ -31,6 +31,16 @@ pub const DEFAULT_IPD_MM: f64 = 63.0;
 /// 78 mm; children reach down to about 40.
 pub const IPD_RANGE_MM: (f64, f64) = (40.0, 80.0);
 
+/// `ipd_mm` as `--ipd-mm` takes it; the error says what is allowed.
+pub fn check_ipd_mm(ipd_mm: f64) -> std::result::Result<f64, String> {
+    let (lo, hi) = IPD_RANGE_MM;
+    if ipd_mm.is_finite() && (lo..=hi).contains(&ipd_mm) {
+        Ok(ipd_mm)
+    } else {
+        Err(format!("--ipd-mm {ipd_mm} is outside {lo} to {hi} mm"))
+    }
+}
+
 /// Which eye: index 0 is the left, 1 the right.
 pub const SIDES: [&str; 2] = ["left", "right"];
 

@@ -36,6 +36,38 @@ pub enum IolPower {
     Auto,
 }
 
+impl IolPower {
+    /// `--iol-d`'s text: a power in D within the IOL range, or `auto`. The error says what is
+    /// allowed; the caller names the option.
+    pub fn parse(text: &str) -> std::result::Result<IolPower, String> {
+        if text.trim().eq_ignore_ascii_case("auto") {
+            return Ok(IolPower::Auto);
+        }
+        let v = text
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{text:?} is not a number; a power in D or auto"))?;
+        let (lo, hi) = crate::eye::correction::IOL_RANGE_D;
+        if (lo..=hi).contains(&v) {
+            Ok(IolPower::Dioptres(v))
+        } else {
+            Err(format!("{v} is outside {lo} to {hi} D"))
+        }
+    }
+}
+
+/// A spectacle's vertex distance as `--vertex-mm` takes it (lens to cornea, mm).
+pub fn check_vertex_mm(vertex_mm: f64) -> std::result::Result<f64, String> {
+    let (lo, hi) = crate::eye::correction::VERTEX_RANGE_MM;
+    if vertex_mm.is_finite() && (lo..=hi).contains(&vertex_mm) {
+        Ok(vertex_mm)
+    } else {
+        Err(format!("{vertex_mm} is outside {lo} to {hi} mm"))
+    }
+}
+
 /// What is put in front of (or into) the eye and how far it accommodates, as asked.
 #[derive(Debug, Clone, Default)]
 pub struct Correction {

@@ -99,14 +99,10 @@ pub enum SceneArg<'a> {
     Loaded(&'a Arc<Scene>),
 }
 
-impl SceneArg<'_> {
-    /// What the caches know the scene by.
-    fn key(&self) -> String {
-        match self {
-            SceneArg::Name(n) => format!("name:{n}"),
-            SceneArg::Loaded(s) => format!("loaded:{}", s.id()),
-        }
-    }
+/// The scene frames are drawn from, and the name that loaded it (None: given loaded).
+struct CurrentScene {
+    named: Option<String>,
+    scene: Arc<Scene>,
 }
 
 /// A rendered frame: linear RGBA and how it was made.
@@ -143,9 +139,9 @@ pub struct Counters {
     pub kernel_preparations: u64,
 }
 
-/// Scene name, time (bits), size, spectacle magnification and camera (bits) of a host frame.
+/// Scene id, time (bits), size, spectacle magnification and camera (bits) of a host frame.
 type HostKey = (
-    String,
+    u64,
     u64,
     (u32, u32),
     Option<[[f64; 2]; 2]>,
@@ -173,7 +169,7 @@ struct Inner {
     /// Most recently used last.
     prepared: Vec<Prepared>,
     rasterizer: Option<Rasterizer>,
-    scene: Option<(String, Arc<Scene>)>,
+    scene: Option<CurrentScene>,
     /// The last scene frames drawn to the host, by what drew them (most recent last): a scene
     /// rendered again at the same time, size and magnification is not drawn to the host again
     /// (splat draws it in its own submission anyway).
@@ -304,9 +300,9 @@ impl LiveRenderer {
             time_s,
             camera,
         )?;
-        let key = scene.key();
+        let id = self.scene(scene)?.id();
         let live =
-            self.render_corrected(&eye, physiology, o, &frame, Some((&key, time_s, camera)))?;
+            self.render_corrected(&eye, physiology, o, &frame, Some((id, time_s, camera)))?;
         Ok((live, warnings))
     }
 
@@ -318,7 +314,7 @@ impl LiveRenderer {
         physiology: Physiology,
         o: &LiveOptions,
         frame: &HostFrame,
-        scene: Option<(&str, f64, Option<Camera>)>,
+        scene: Option<(u64, f64, Option<Camera>)>,
     ) -> Result<LiveFrame> {
         let (focus_d, focus_from) = frame.focus_d(o.focus)?;
         let (pupil_mm, pupil_from) = pupil_diameter(o, frame)?;
@@ -400,8 +396,8 @@ impl LiveRenderer {
         );
         renderer.set_display_white(crate::render::splat::display_white(exposure_ev));
         let rendered = match (scene, rasterizer.as_mut(), loaded.as_ref()) {
-            (Some((name, time_s, camera)), Some(raster), Some((loaded_name, scene)))
-                if o.method == Method::Splat && name == loaded_name =>
+            (Some((id, time_s, camera)), Some(raster), Some(CurrentScene { scene, .. }))
+                if o.method == Method::Splat && scene.id() == id =>
             {
                 let gap_d = crate::render::blend::DEFAULT_GROUP_TOLERANCE_D;
                 let mut scene_state = scene.at_time(time_s);
@@ -448,6 +444,26 @@ impl LiveRenderer {
         })
     }
 
+    /// The scene `arg` names, loaded on first use and kept while it stays the current one
+    /// (host frames and uploaded geometry follow it).
+    pub fn scene(&self, arg: SceneArg<'_>) -> Result<Arc<Scene>> {
+        let mut inner = self.lock();
+        let current = match (&inner.scene, arg) {
+            (Some(c), SceneArg::Name(n)) => c.named.as_deref() == Some(n),
+            (Some(c), SceneArg::Loaded(s)) => c.scene.id() == s.id(),
+            (None, _) => false,
+        };
+        if !current {
+            let (named, scene) = match arg {
+                SceneArg::Name(n) => (Some(n.to_string()), Arc::new(Scene::load(n)?)),
+                SceneArg::Loaded(s) => (None, Arc::clone(s)),
+            };
+            inner.scene = Some(CurrentScene { named, scene });
+            inner.host.clear();
+        }
+        Ok(Arc::clone(&inner.scene.as_ref().expect("set above").scene))
+    }
+
     /// The scene's layer 0 on the host (for depth range, focus and pupil, and the methods
     /// that read pixels), drawn through the spectacle `magnification`.
     pub fn scene_frame(
@@ -481,20 +497,12 @@ impl LiveRenderer {
                 )));
             }
         }
-        let name = scene.key();
+        let loaded = self.scene(scene)?;
         let mut inner = self.lock();
-        if inner.scene.as_ref().is_none_or(|(n, _)| *n != name) {
-            let loaded = match scene {
-                SceneArg::Name(n) => Arc::new(Scene::load(n)?),
-                SceneArg::Loaded(s) => Arc::clone(s),
-            };
-            inner.scene = Some((name.clone(), loaded));
-            inner.host.clear();
-        }
-        let scene_resolution = inner.scene.as_ref().expect("loaded above").1.resolution;
+        let scene_resolution = loaded.resolution;
         let size_px = size.unwrap_or((scene_resolution[0], scene_resolution[1]));
         let host_key: HostKey = (
-            name.to_string(),
+            loaded.id(),
             time_s.to_bits(),
             size_px,
             magnification,
@@ -509,13 +517,7 @@ impl LiveRenderer {
         if inner.rasterizer.is_none() {
             inner.rasterizer = Some(Rasterizer::new(&self.ctx)?);
         }
-        let Inner {
-            rasterizer, scene, ..
-        } = &mut *inner;
-        let (raster, scene) = (
-            rasterizer.as_mut().expect("made above"),
-            &scene.as_ref().expect("loaded above").1,
-        );
+        let (raster, scene) = (inner.rasterizer.as_mut().expect("made above"), &loaded);
         raster.set_view_magnification(magnification.unwrap_or([[1.0, 0.0], [0.0, 1.0]]));
         let mut state = scene.at_time(time_s);
         if let Some(c) = camera {

@@ -4,9 +4,9 @@
 use serde::Deserialize;
 
 use super::catalog::Catalog;
-use crate::eye::correction::{parse_rx, DEFAULT_VERTEX_MM, IOL_RANGE_D, VERTEX_RANGE_MM};
+use crate::eye::correction::{parse_rx, DEFAULT_VERTEX_MM};
 use crate::render::frame::Method;
-use crate::render::frame_plan::{Correction, FocusAsked, IolPower};
+use crate::render::frame_plan::{check_vertex_mm, Correction, FocusAsked, IolPower};
 use crate::render::live::LiveOptions;
 use crate::render::splat::Quality;
 
@@ -206,11 +206,8 @@ fn check_correction(c: CorrectionIn) -> Checked<(Correction, Vec<String>)> {
     Ok(match c {
         CorrectionIn::None => (Correction::default(), Vec::new()),
         CorrectionIn::Glasses { rx, vertex_mm } => {
-            let vertex = vertex_mm.unwrap_or(DEFAULT_VERTEX_MM);
-            let (lo, hi) = VERTEX_RANGE_MM;
-            if !(vertex.is_finite() && (lo..=hi).contains(&vertex)) {
-                return Err(format!("--vertex-mm {vertex} is outside {lo} to {hi} mm"));
-            }
+            let vertex = check_vertex_mm(vertex_mm.unwrap_or(DEFAULT_VERTEX_MM))
+                .map_err(|e| format!("--vertex-mm: {e}"))?;
             let s = parse_rx(&rx, vertex).map_err(|e| format!("--correct {rx:?}: {e}"))?;
             (
                 Correction {
@@ -242,21 +239,7 @@ fn check_correction(c: CorrectionIn) -> Checked<(Correction, Vec<String>)> {
             )
         }
         CorrectionIn::Iol { power } => {
-            let iol = if power.trim().eq_ignore_ascii_case("auto") {
-                IolPower::Auto
-            } else {
-                let (lo, hi) = IOL_RANGE_D;
-                let d = power
-                    .trim()
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|d| d.is_finite())
-                    .ok_or_else(|| format!("--iol-d {power:?} is not a power in D or auto"))?;
-                if !(lo..=hi).contains(&d) {
-                    return Err(format!("--iol-d {d} is outside {lo} to {hi} D"));
-                }
-                IolPower::Dioptres(d)
-            };
+            let iol = IolPower::parse(&power).map_err(|e| format!("--iol-d {power:?}: {e}"))?;
             (
                 Correction {
                     iol: Some(iol),

@@ -11,9 +11,9 @@ use crate::common::{finish, gpu, module_cache, ocular_run, temp_dir};
 const SIZE: (u32, u32) = (640, 360);
 const FOV_Y_DEG: f64 = 20.0;
 
-/// A scene of one white sphere on the midline `d_m` ahead, lit evenly, on near black; its radius
-/// spans about 8 pixels at any distance.
-fn marker_scene(d_m: f64) -> Scene {
+/// A scene of one white sphere `d_m` ahead and `x_m` right of the view, lit evenly, on near
+/// black; its radius spans about 8 pixels at any distance.
+fn marker_scene(x_m: f64, d_m: f64) -> Scene {
     let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
     let radius = d_m * 8.0 / focal;
     let text = format!(
@@ -24,7 +24,7 @@ position = [0.0, 0.0, 0.0]
 look_at = [0.0, 0.0, -1.0]
 fov_y_deg = {FOV_Y_DEG}
 near_m = 0.05
-far_m = 50.0
+far_m = 500.0
 resolution = [{w}, {h}]
 [background]
 color = [1.0, 1.0, 1.0]
@@ -36,7 +36,7 @@ illuminance_lux = 300.0
 kind = "sphere"
 radius_m = {radius}
 segments = 256
-translate = [0.0, 0.0, {z}]
+translate = [{x_m}, 0.0, {z}]
 color = [0.8, 0.8, 0.8]
 "#,
         w = SIZE.0,
@@ -44,6 +44,27 @@ color = [0.8, 0.8, 0.8]
         z = -d_m
     );
     Scene::from_toml(&text, "marker scene", std::path::Path::new(".")).unwrap()
+}
+
+/// An eye file estimated from the prescription `rx` (4 mm pupil) by the CLI, in `dir`.
+fn estimated_eye(dir: &std::path::Path, rx: &str) -> std::path::PathBuf {
+    let file = dir.join(format!("eye{rx}.toml"));
+    let out = ocular_run(&[
+        "eye",
+        "estimate",
+        "--rx",
+        rx,
+        "--pupil-mm",
+        "4",
+        "-o",
+        file.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    file
 }
 
 /// The centroid of a frame's light above its background, in pixel coordinates (a pixel's
@@ -75,7 +96,7 @@ fn midline_points_land_at_the_disparity_of_converging_eyes() {
     let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
     let (cx, cy) = (0.5 * f64::from(SIZE.0), 0.5 * f64::from(SIZE.1));
     for d in [0.5, 1.0, fixation_m, 4.0] {
-        let scene = marker_scene(d);
+        let scene = marker_scene(0.0, d);
         let mut state = scene.at_time(0.0);
         let camera = state.camera;
         let positions = eye_positions(&camera, 2.0 * b);
@@ -112,7 +133,7 @@ fn midline_points_land_at_the_disparity_of_converging_eyes() {
         }
     }
     // A control: parallel eyes (fixation at infinity) do not centre the point at 2 m.
-    let scene = marker_scene(fixation_m);
+    let scene = marker_scene(0.0, fixation_m);
     let mut state = scene.at_time(0.0);
     let parallel = eye_cameras(&state.camera, 2.0 * b, None);
     state.camera = parallel[0];
@@ -143,22 +164,7 @@ fn a_monovision_pair_shares_one_accommodation() {
     let cache = cache.to_str().unwrap();
     // The left eye emmetropic, the right myopic by 1.5 D: the same eye behind a +1.5 D contact
     // lens would be the textbook fit; here two eyes estimated from prescriptions.
-    let near_eye = dir.join("near.toml");
-    let out = ocular_run(&[
-        "eye",
-        "estimate",
-        "--rx",
-        "-1.5",
-        "--pupil-mm",
-        "4",
-        "-o",
-        near_eye.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let near_eye = estimated_eye(&dir, "-1.5");
     let output = dir.join("view.png");
     let run = |focus_m: &str| {
         json(&[
@@ -308,22 +314,7 @@ fn monovision_frames_are_sharp_where_each_eye_drives_and_independent_eyes_would_
     use ocular::render::live::{LiveOptions, LiveRenderer, SceneArg};
 
     let dir = temp_dir("monovision-frames");
-    let near_file = dir.join("near.toml");
-    let out = ocular_run(&[
-        "eye",
-        "estimate",
-        "--rx",
-        "-1.5",
-        "--pupil-mm",
-        "4",
-        "-o",
-        near_file.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let near_file = estimated_eye(&dir, "-1.5");
     let near_eye = ocular::eye::load(&near_file).unwrap().eye;
     let far_eye = ocular::eye::Eye::preset("healthy").unwrap();
     let live = LiveRenderer::new(gpu(), Some(module_cache()), 4);
@@ -446,59 +437,15 @@ fn glasses_of_different_powers_give_each_eye_its_image_size() {
     let (distance_m, angle_deg): (f64, f64) = (100.0, 5.0);
     let x_m = distance_m * angle_deg.to_radians().tan();
     let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
-    let text = format!(
-        r#"
-name = "far marker"
-[camera]
-position = [0.0, 0.0, 0.0]
-look_at = [0.0, 0.0, -1.0]
-fov_y_deg = {FOV_Y_DEG}
-near_m = 0.05
-far_m = 500.0
-resolution = [{w}, {h}]
-[background]
-color = [1.0, 1.0, 1.0]
-luminance_cd_m2 = 0.01
-[[light]]
-kind = "ambient"
-illuminance_lux = 300.0
-[[object]]
-kind = "sphere"
-radius_m = {r}
-segments = 256
-translate = [{x_m}, 0.0, {z}]
-color = [0.8, 0.8, 0.8]
-"#,
-        w = SIZE.0,
-        h = SIZE.1,
-        r = distance_m * 8.0 / focal,
-        z = -distance_m
-    );
-    let scene = std::sync::Arc::new(
-        Scene::from_toml(&text, "far marker", std::path::Path::new(".")).unwrap(),
-    );
+    let scene = std::sync::Arc::new(marker_scene(x_m, distance_m));
     // An anisometropic pair: a mild and a strong myope, each in glasses of its own power; eyes
     // estimated from the prescriptions alone have no coma to shift an image's centroid.
     let powers_d = [-0.25, -6.0];
     let dir = temp_dir("aniseikonia");
     let eyes = powers_d.map(|p| {
-        let file = dir.join(format!("eye{p}.toml"));
-        let out = ocular_run(&[
-            "eye",
-            "estimate",
-            "--rx",
-            &format!("{p}"),
-            "--pupil-mm",
-            "4",
-            "-o",
-            file.to_str().unwrap(),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        ocular::eye::load(&file).unwrap().eye
+        ocular::eye::load(&estimated_eye(&dir, &format!("{p}")))
+            .unwrap()
+            .eye
     });
     let vertex_mm = 12.0;
     let corrections = powers_d.map(|p| Correction {
