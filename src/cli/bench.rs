@@ -236,6 +236,7 @@ impl SceneInput<'_, '_> {
             depth_m: &frames[0].depth_m,
             fov_y_deg: self.state.camera.fov_y_deg,
             hidden_layers: &hidden,
+            mixed: None,
         };
         let mut out = renderer.render(&input, eye, Method::Splat)?;
         // a pass drawn once per layer counts once per frame, its times summed
@@ -367,7 +368,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let ctx = Context::new(&cli.context_options())?;
     let (width, height) = args.size;
     let (frame, eye_state, screen) =
-        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
+        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm, false)?;
     // the white `render` would show this frame at, as the unit of the merge's colour bound
     splat.merge.white = crate::render::splat::display_white(
         crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color),

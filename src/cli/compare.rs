@@ -82,6 +82,14 @@ pub struct CompareArgs {
     /// Skip the slice method.
     #[arg(long)]
     pub no_slices: bool,
+    /// How the reference reads a pixel a silhouette crosses: `whole` (one fragment of the
+    /// pixel's mean colour at the nearest surface's depth, as every method does) or `split`
+    /// (the nearest surface over its share of the pixel's samples and what lies behind over
+    /// the rest, each with its own depth's kernel). Splat and slices always read the pixel
+    /// whole: the split, measured against --truth views, moved the edge band away from it
+    /// (docs/validation.md, "Mixed pixels").
+    #[arg(long, value_enum, default_value = "whole")]
+    pub edge_pixels: crate::render::blend::EdgePixels,
     /// Render splat once and time that frame (shader compilation and the kernels' upload
     /// included) instead of timing a second frame: halves splat's cost where one frame takes
     /// minutes (off axis at 1280×720 on a CPU device).
@@ -162,8 +170,10 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
     let (width, height) = args.size;
+    let split = args.edge_pixels == crate::render::blend::EdgePixels::Split;
     let (frame, eye_state, screen) =
-        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm)?;
+        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm, split)?;
+    splat.blend.edge_pixels = args.edge_pixels;
     // Compare what a person sees: every image at the input frame's automatic exposure, which
     // is also the white splat's merge bounds its colour error by.
     let exposure_ev = crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color);

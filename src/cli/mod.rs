@@ -152,6 +152,7 @@ impl BlendArgs {
             mode: self.blend,
             group_tolerance_d: self.group_tolerance_d,
             wide_field: !self.narrow_field,
+            edge_pixels: crate::render::blend::EdgePixels::Whole,
         }
     }
 }
@@ -342,6 +343,7 @@ pub(crate) fn measured_scene_frame(
     scene: &crate::scene::Scene,
     (width, height): (u32, u32),
     pupil_mm: Option<f64>,
+    mixed_pixels: bool,
 ) -> Result<(
     crate::render::Frame,
     crate::render::frame::EyeState,
@@ -349,7 +351,9 @@ pub(crate) fn measured_scene_frame(
 )> {
     use crate::render::frame_plan::{self, FrameView, PupilAsked, PupilFallback, SceneEye};
     let state = scene.at_time(0.0);
-    let frame = crate::render::Rasterizer::new(ctx)?.render(ctx, &state, width, height)?;
+    let mut rasterizer = crate::render::Rasterizer::new(ctx)?;
+    rasterizer.set_mixed_pixels(mixed_pixels);
+    let frame = rasterizer.render(ctx, &state, width, height)?;
     let view = FrameView {
         width,
         height,

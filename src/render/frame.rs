@@ -251,6 +251,7 @@ impl HostFrame {
             depth_m: &self.depth_m,
             fov_y_deg: self.fov_y_deg,
             hidden_layers: &hidden,
+            mixed: None,
         };
         renderer.render(&input, state, method)
     }
@@ -496,28 +497,25 @@ impl FrameRenderer {
                     self.settings.clone(),
                     self.kernels.grid.max_radius_px,
                 )?;
+                // The reference keeps the default blend whatever splat's (it is the fixed
+                // truth of the kernel pipeline), except how edge pixels enter it: the frame's
+                // mixed pixels are part of its input, which both methods read alike.
+                let blend = BlendSettings {
+                    edge_pixels: self.splat_settings.blend.edge_pixels,
+                    ..BlendSettings::default()
+                };
                 let color = if let (Some(_), Method::Reference) = (&self.kernels.field, method) {
                     let wavelengths = self.kernels.grid.wavelengths_nm;
                     let field =
                         ExactFieldEye::new(exact, wavelengths, self.reference_field_step_deg)?;
-                    reference::render_binned(
-                        input,
-                        &field,
-                        &BlendSettings::default(),
-                        self.reference_dioptre_bin_d,
-                    )
+                    reference::render_binned(input, &field, &blend, self.reference_dioptre_bin_d)
                 } else if self.kernels.field.is_some() {
                     return Err(Error::input(
                         "--off-axis applies to --method splat and reference; slices use one PSF \
                          per depth slice",
                     ));
                 } else if method == Method::Reference {
-                    reference::render_binned(
-                        input,
-                        &exact,
-                        &BlendSettings::default(),
-                        self.reference_dioptre_bin_d,
-                    )
+                    reference::render_binned(input, &exact, &blend, self.reference_dioptre_bin_d)
                 } else {
                     slices::render(input, &exact, self.slice_count)
                 };

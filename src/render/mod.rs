@@ -26,7 +26,7 @@ pub mod views;
 // Rasterising a scene into colour and depth.
 pub use raster::{Frame, Rasterizer, SurfaceInputs, MSAA_SAMPLES};
 // How layers of fragments are blended.
-pub use blend::{BlendMode, BlendSettings, DEFAULT_GROUP_TOLERANCE_D};
+pub use blend::{BlendMode, BlendSettings, EdgePixels, DEFAULT_GROUP_TOLERANCE_D};
 // One frame from a scene and an eye: its kernels and its renderer.
 pub use frame::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,

@@ -4,7 +4,9 @@
 //! pass to a single-sample RGBA32F image) and a view-depth target (R32F, the distance along
 //! the view direction in metres, written per sample). A compute pass (raster.comp) then
 //! resolves depth with the nearest sample instead of an average, so depth never blends
-//! across an edge. Pixels no object covers get the background colour and depth `far_m`.
+//! across an edge; asked to ([`Rasterizer::set_mixed_pixels`]), it also writes what lies behind
+//! the nearest surface in each pixel's samples (`Frame::rest`). Pixels no object covers get the
+//! background colour and depth `far_m`.
 //! Colour is 32-bit float throughout: values are cd/m², and lamps, the sun and specular
 //! emitters exceed half float's 65504 (a half-float target clipped them silently).
 //!
@@ -51,6 +53,13 @@ pub struct Frame {
     pub color: Vec<[f32; 4]>,
     /// Distance along the view direction (camera z), metres.
     pub depth_m: Vec<f32>,
+    /// Mixed pixels ([`crate::render::splat::MixedPixels`]): per pixel, rgb the mean colour
+    /// of the samples behind the nearest surface's depth group and a that group's share of
+    /// the pixel (1 where the pixel shows one surface). Empty for a peeled layer and unless
+    /// asked for ([`Rasterizer::set_mixed_pixels`]).
+    pub rest: Vec<[f32; 4]>,
+    /// The nearest view depth among those samples (m); +∞ where there are none.
+    pub rest_depth_m: Vec<f32>,
     /// GPU time per pass ("raster", "depth resolve", "read back").
     pub timings: Timings,
 }
@@ -73,7 +82,16 @@ impl Frame {
             depth_m: &self.depth_m,
             fov_y_deg,
             hidden_layers: &[],
+            mixed: self.mixed(),
         }
+    }
+
+    /// How silhouettes split this frame's pixels between surfaces (None for a peeled layer).
+    pub fn mixed(&self) -> Option<crate::render::splat::MixedPixels<'_>> {
+        (!self.rest.is_empty()).then_some(crate::render::splat::MixedPixels {
+            rest: &self.rest,
+            rest_depth_m: &self.rest_depth_m,
+        })
     }
 }
 
@@ -113,6 +131,9 @@ shader_block! {
         width: u32,
         height: u32,
         samples: u32,
+        /// 1: also write the rest of mixed pixels (the visible layer); 0: depth only.
+        split: u32,
+        group_tolerance_d: f32,
     }
 }
 
@@ -128,6 +149,8 @@ struct GpuScene {
 struct Targets {
     width: u32,
     height: u32,
+    /// Whether `color_ms` can be sampled (made so when mixed pixels are asked for).
+    color_sampled: bool,
     color_ms: Image,
     depth_ms: Image,
     /// View depth per sample of layer 0 and every even layer.
@@ -138,9 +161,13 @@ struct Targets {
     peel: Option<PeelTargets>,
     /// The resolved depth (view-axis metres, row-major), on the device.
     depth: Buffer,
-    /// Persistent read-back buffers (colour, depth) of the host path (`render`,
-    /// `render_layers`), made at its first frame: a frame that stays on the GPU needs none.
-    readback: Option<(Buffer, Buffer)>,
+    /// The rest of mixed pixels (raster.comp's `Rest`, `RestDepth`), on the device.
+    rest: Buffer,
+    rest_depth: Buffer,
+    /// Persistent read-back buffers (colour, depth, rest, rest depth) of the host path
+    /// (`render`, `render_layers`), made at its first frame: a frame that stays on the GPU
+    /// needs none.
+    readback: Option<[Buffer; 4]>,
 }
 
 /// Layer k is drawn into the view depth of its parity (`Targets::view_depth_ms` for even k, the
@@ -175,6 +202,8 @@ pub struct Rasterizer {
     /// How directions in front of the eye appear (view-space x, y: +x right, +y up): the
     /// angular magnification of a spectacle lens, identity without one.
     view_magnification: [[f64; 2]; 2],
+    /// Whether the visible layer's resolve also writes its mixed pixels (`Frame::rest`).
+    mixed_pixels: bool,
 }
 
 impl Rasterizer {
@@ -216,6 +245,7 @@ impl Rasterizer {
                 Residency::Upload,
             )?,
             view_magnification: [[1.0, 0.0], [0.0, 1.0]],
+            mixed_pixels: false,
         })
     }
 
@@ -307,11 +337,9 @@ impl Rasterizer {
     }
 
     fn ensure_targets(&mut self, ctx: &Context, width: u32, height: u32) -> Result<()> {
-        if self
-            .targets
-            .as_ref()
-            .is_some_and(|t| t.width == width && t.height == height)
-        {
+        if self.targets.as_ref().is_some_and(|t| {
+            t.width == width && t.height == height && t.color_sampled == self.mixed_pixels
+        }) {
             return Ok(());
         }
         self.targets = None;
@@ -326,10 +354,12 @@ impl Rasterizer {
         let target = |name: &str, format: TexelFormat, usage: ImageUsage| {
             Image::new_2d(ctx, name, width, height, format, usage)
         };
+        // sampled only where the resolve reads the samples behind a silhouette apart
+        // (raster.comp): a sampled attachment may lose a GPU's colour compression
         let color_ms = target(
             "raster colour (MSAA)",
             TexelFormat::Rgba32Float,
-            attachment(false, false, MSAA_SAMPLES),
+            attachment(false, self.mixed_pixels, MSAA_SAMPLES),
         )?;
         let view_depth_ms = target(
             "raster view depth (MSAA)",
@@ -359,10 +389,23 @@ impl Rasterizer {
         let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
             depth: Buffer::new(ctx, "raster depth", pixels * 4, Residency::Device)?,
+            rest: Buffer::new(
+                ctx,
+                "raster mixed-pixel rest",
+                pixels * 16,
+                Residency::Device,
+            )?,
+            rest_depth: Buffer::new(
+                ctx,
+                "raster mixed-pixel rest depth",
+                pixels * 4,
+                Residency::Device,
+            )?,
             readback: None,
             width,
             height,
             peel: None,
+            color_sampled: self.mixed_pixels,
             color_ms,
             depth_ms,
             view_depth_ms,
@@ -417,6 +460,13 @@ impl Rasterizer {
     /// stays the distance along the camera's view axis: the element moves images, not objects.
     pub fn set_view_magnification(&mut self, m: [[f64; 2]; 2]) {
         self.view_magnification = m;
+    }
+
+    /// Whether later frames read back their mixed pixels ([`Frame::rest`]): what lies behind
+    /// the nearest surface's depth group in each pixel's samples. Off by default: only the
+    /// comparison's `--edge-pixels split` reads them (docs/validation.md, "Mixed pixels").
+    pub fn set_mixed_pixels(&mut self, on: bool) {
+        self.mixed_pixels = on;
     }
 
     /// World → clip of `camera` for this frame, with the view magnification.
@@ -519,37 +569,51 @@ impl Rasterizer {
         let targets = self.targets.as_mut().expect("prepared");
         if targets.readback.is_none() {
             let pixels = u64::from(width) * u64::from(height);
-            targets.readback = Some((
-                Buffer::new(
-                    ctx,
-                    "raster colour read-back",
-                    pixels * 16,
-                    Residency::Readback,
-                )?,
-                Buffer::new(
-                    ctx,
-                    "raster depth read-back",
-                    pixels * 4,
-                    Residency::Readback,
-                )?,
-            ));
+            let readback = |name: &str, bytes: u64| {
+                Buffer::new(ctx, name, pixels * bytes, Residency::Readback)
+            };
+            targets.readback = Some([
+                readback("raster colour read-back", 16)?,
+                readback("raster depth read-back", 4)?,
+                readback("raster rest read-back", 16)?,
+                readback("raster rest depth read-back", 4)?,
+            ]);
         }
         let targets = self.targets.as_ref().expect("prepared");
-        let (color_readback, depth_readback) = targets.readback.as_ref().expect("made above");
+        let [color_readback, depth_readback, rest_readback, rest_depth_readback] =
+            targets.readback.as_ref().expect("made above");
         let layer = peel.map_or(0, |(layer, _)| layer);
         let timings = ctx.submit(|rec| {
             self.record(rec, state, layer)?;
             rec.begin_pass("read back");
             rec.copy_image_to_buffer(&targets.color, color_readback);
             rec.copy_buffer(&targets.depth, depth_readback, targets.depth.size_bytes());
+            if layer == 0 && self.mixed_pixels {
+                rec.copy_buffer(&targets.rest, rest_readback, targets.rest.size_bytes());
+                rec.copy_buffer(
+                    &targets.rest_depth,
+                    rest_depth_readback,
+                    targets.rest_depth.size_bytes(),
+                );
+            }
             Ok(())
         })?;
         let pixels = width as usize * height as usize;
+        let (rest, rest_depth_m) = if layer == 0 && self.mixed_pixels {
+            (
+                rest_readback.read_mapped(0, pixels)?,
+                rest_depth_readback.read_mapped(0, pixels)?,
+            )
+        } else {
+            (Vec::new(), Vec::new())
+        };
         Ok(Frame {
             width,
             height,
             color: color_readback.read_mapped(0, pixels)?,
             depth_m: depth_readback.read_mapped(0, pixels)?,
+            rest,
+            rest_depth_m,
             timings,
         })
     }
@@ -709,14 +773,31 @@ impl Rasterizer {
                 (targets.view_depth(layer), &self.point_sampler),
             )
             .write("Depth", &targets.depth)
+            // without the split the shader reads no colour sample: any multisampled image
+            // that can be sampled stands in
+            .read(
+                "color_samples",
+                (
+                    if targets.color_sampled {
+                        &targets.color_ms
+                    } else {
+                        targets.view_depth(layer)
+                    },
+                    &self.point_sampler,
+                ),
+            )
+            .write("Rest", &targets.rest)
+            .write("RestDepth", &targets.rest_depth)
             .push(&ResolvePush {
                 width,
                 height,
                 samples: MSAA_SAMPLES,
+                split: u32::from(layer == 0 && self.mixed_pixels),
+                group_tolerance_d: crate::render::blend::DEFAULT_GROUP_TOLERANCE_D,
             })
             .dispatch([width.div_ceil(8), height.div_ceil(8), 1])?;
-        // The MSAA targets live as long as the framebuffers that use them.
-        let _ = (&targets.color_ms, &targets.depth_ms);
+        // The MSAA depth buffer lives as long as the framebuffers that use it.
+        let _ = &targets.depth_ms;
         Ok(())
     }
 

@@ -3,7 +3,10 @@
 //! pinhole's local scale — no interpolation over distance or radius, no merging — with the
 //! blend of [`super::blend`] (which it shares with the splat runtime: it judges the kernel
 //! pipeline, not the blend; the blend is judged against plain convolutions in the tests). It is
-//! written independently of the GPU passes (CPU, rayon, per tile).
+//! written independently of the GPU passes (CPU, rayon, per tile). With
+//! [`super::EdgePixels::Split`] and a frame's mixed pixels it splits each pixel a silhouette
+//! crosses into two fragments (`compare --edge-pixels split`, a measurement: docs/validation.md,
+//! "Mixed pixels").
 
 use std::sync::Arc;
 
@@ -56,15 +59,49 @@ pub fn render_binned(
     let (w, h) = (input.width as usize, input.height as usize);
     let projection = input.projection();
     let wide = blend.wide_field;
-    let dioptres: Vec<f64> = if wide {
-        projection.dioptres(input.depth_m)
-    } else {
-        input
-            .depth_m
-            .iter()
-            .map(|&d| vergence_of_depth_d(d))
-            .collect()
+    let vergences = |depth_m: &[f32]| -> Vec<f64> {
+        if wide {
+            projection.dioptres(depth_m)
+        } else {
+            depth_m.iter().map(|&d| vergence_of_depth_d(d)).collect()
+        }
     };
+    let dioptres = vergences(input.depth_m);
+    let mixed = input
+        .mixed
+        .filter(|_| blend.edge_pixels == super::blend::EdgePixels::Split);
+    // The fragments: one per pixel (the visible surface: its own colour and its share of the
+    // pixel where a silhouette splits it), then one per split pixel for what lies behind
+    // (MixedPixels), in pixel order.
+    let mut fragments: Vec<Fragment> = (0..w * h)
+        .map(|i| Fragment {
+            pixel: i,
+            dioptre: dioptres[i],
+            color: match &mixed {
+                Some(m) => m.near_color(i, input.color[i]),
+                None => [input.color[i][0], input.color[i][1], input.color[i][2]],
+            },
+            share: mixed.as_ref().map_or(1.0, |m| m.share(i)),
+        })
+        .collect();
+    // index of the pixel's second fragment, u32::MAX where it has none
+    let mut rest_of = vec![u32::MAX; w * h];
+    if let Some(m) = &mixed {
+        let rest_dioptres = vergences(m.rest_depth_m);
+        for i in 0..w * h {
+            let share = m.share(i);
+            if share < 1.0 && m.rest_depth_m[i] > 0.0 && !m.rest_depth_m[i].is_nan() {
+                rest_of[i] = fragments.len() as u32;
+                let r = m.rest[i];
+                fragments.push(Fragment {
+                    pixel: i,
+                    dioptre: rest_dioptres[i],
+                    color: [r[0], r[1], r[2]],
+                    share: 1.0 - share,
+                });
+            }
+        }
+    }
     // Off axis each pixel also has a field bin: (h, v) rounded to the source's field step.
     let field_bins: Vec<(i64, i64)> = match kernels.field_step_deg() {
         None => vec![(0, 0); w * h],
@@ -80,13 +117,15 @@ pub fn render_binned(
                 .collect()
         }
     };
-    let bins: Vec<Bin> = dioptres
+    let bins: Vec<Bin> = fragments
         .iter()
-        .zip(&field_bins)
-        .map(|(&d, &(fh, fv))| (bin_of(d, dioptre_bin_d), fh, fv))
+        .map(|f| {
+            let (fh, fv) = field_bins[f.pixel];
+            (bin_of(f.dioptre, dioptre_bin_d), fh, fv)
+        })
         .collect();
-    // Each pixel's three kernels are found once here, not per (pixel, fragment, channel) in the
-    // loop below, where a keyed lookup was a sixth of the time.
+    // Each fragment's three kernels are found once here, not per (pixel, fragment, channel)
+    // in the loop below, where a keyed lookup was a sixth of the time.
     let (distinct, kernel_table) = exact_kernels_for(&bins, kernels, dioptre_bin_d);
     let slots: Vec<usize> = bins
         .iter()
@@ -103,23 +142,20 @@ pub fn render_binned(
         })
         .collect();
 
-    // Reach of each pixel's fragment in screen pixels: the largest kernel radius over its
-    // channels, stretched by the local scale (bilinear lookups reach one texel further).
-    // The largest kernel radius over each fragment's channels sets how much of the local scale
-    // applies, and with it the fragment's reach in screen pixels.
-    let natural: Vec<u32> = (0..w * h)
+    // Reach of each fragment in screen pixels: the largest kernel radius over its channels,
+    // stretched by the local scale (bilinear lookups reach one texel further). The largest
+    // kernel radius over each fragment's channels sets how much of the local scale applies,
+    // and with it the fragment's reach in screen pixels.
+    let natural: Vec<u32> = (0..fragments.len())
         .map(|i| kernel_of(i).iter().map(|k| k.radius).max().unwrap_or(0))
         .collect();
     // The continuous radius, as the runtime's fragments carry it: the block radius is its
     // ceiling, and would switch the local scale on in steps.
-    let radius_px: Vec<f64> = (0..w * h)
+    let radius_px: Vec<f64> = (0..fragments.len())
         .map(|i| kernel_of(i).iter().map(|k| k.radius_px).fold(0.0, f64::max))
         .collect();
-    let reach: Vec<i64> = natural
-        .iter()
-        .zip(&radius_px)
-        .zip(&scales)
-        .map(|((&r, &rp), s)| i64::from(s.reach_px(r, rp)))
+    let reach: Vec<i64> = (0..fragments.len())
+        .map(|i| i64::from(scales[fragments[i].pixel].reach_px(natural[i], radius_px[i])))
         .collect();
     let max_reach = reach.iter().copied().max().unwrap_or(0);
     // The coverage a near fragment's groups leave is filled with what surrounds it
@@ -129,11 +165,15 @@ pub fn render_binned(
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
     // Front to back along each pixel's ray (ties by index, deterministic).
-    let keys: Vec<(u32, u32)> = dioptres
+    let keys: Vec<(u32, u32)> = fragments
         .iter()
         .enumerate()
-        .map(|(i, &d)| {
-            let distance = if d > 0.0 { (1.0 / d) as f32 } else { 3.0e38 };
+        .map(|(i, f)| {
+            let distance = if f.dioptre > 0.0 {
+                (1.0 / f.dioptre) as f32
+            } else {
+                3.0e38
+            };
             (distance.to_bits(), i as u32)
         })
         .collect();
@@ -153,10 +193,15 @@ pub fn render_binned(
             let (sx0, sx1) = ((x0 - max_reach).max(0), (x1 + max_reach).min(w as i64 - 1));
             for sy in sy0..=sy1 {
                 for sx in sx0..=sx1 {
-                    let i = sy as usize * w + sx as usize;
-                    let r = reach[i];
-                    if sx + r >= x0 && sx - r <= x1 && sy + r >= y0 && sy - r <= y1 {
-                        list.push(i as u32);
+                    let pixel = sy as usize * w + sx as usize;
+                    for i in [pixel as u32, rest_of[pixel]] {
+                        if i == u32::MAX {
+                            continue;
+                        }
+                        let r = reach[i as usize];
+                        if sx + r >= x0 && sx - r <= x1 && sy + r >= y0 && sy - r <= y1 {
+                            list.push(i);
+                        }
                     }
                 }
             }
@@ -167,11 +212,12 @@ pub fn render_binned(
                     let mut pixel = [PixelBlend::default(); 3];
                     for &i in &list {
                         let i = i as usize;
-                        let (fx, fy) = ((i % w) as i64, (i / w) as i64);
+                        let f = &fragments[i];
+                        let (fx, fy) = ((f.pixel % w) as i64, (f.pixel / w) as i64);
                         if (px - fx).abs() > reach[i] || (py - fy).abs() > reach[i] {
                             continue;
                         }
-                        let s = &scales[i];
+                        let s = &scales[f.pixel];
                         let d = [(px - fx) as f64, (py - fy) as f64];
                         let r = radius_px[i];
                         let scaled = s.for_radius(r)[0] < 1.0;
@@ -185,14 +231,13 @@ pub fn render_binned(
                         if scaled && (kx.abs() >= bound || ky.abs() >= bound) {
                             continue;
                         }
-                        for ((p, k), &c) in pixel.iter_mut().zip(kernel_of(i)).zip(&input.color[i])
-                        {
+                        for ((p, k), &c) in pixel.iter_mut().zip(kernel_of(i)).zip(&f.color) {
                             let weight = if scaled {
                                 k.sample(kx, ky) * s.area_factor(r) as f32
                             } else {
                                 k.at(d[0] as i64, d[1] as i64)
                             };
-                            p.add(blend, dioptres[i] as f32, weight, c);
+                            p.add(blend, f.dioptre as f32, weight * f.share, c);
                         }
                     }
                     let behind = fill.then(|| {
@@ -200,10 +245,7 @@ pub fn render_binned(
                             (w, h),
                             (px as usize, py as usize),
                             &|i| dioptres[i] as f32,
-                            &|i| {
-                                let c = input.color[i];
-                                [c[0], c[1], c[2]]
-                            },
+                            &|i| fragments[i].color,
                             radius_px[py as usize * w + px as usize] as f32,
                             blend.group_tolerance_d,
                         )
@@ -224,6 +266,17 @@ pub fn render_binned(
         image[index] = value;
     }
     image
+}
+
+/// One fragment of the truth: a pixel's visible surface, or what a silhouette lets through
+/// in the rest of the pixel.
+struct Fragment {
+    pixel: usize,
+    /// Vergence along the pixel's ray (D).
+    dioptre: f64,
+    color: [f32; 3],
+    /// Its share of the pixel (1 unless a silhouette splits it).
+    share: f32,
 }
 
 /// A pixel's kernel bin: dioptre bin, then field bins along h and v (0 on axis).

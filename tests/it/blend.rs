@@ -46,6 +46,7 @@ impl Frame {
             depth_m: &self.depth,
             fov_y_deg: self.fov_y_deg,
             hidden_layers: &[],
+            mixed: None,
         }
     }
 }
@@ -336,7 +337,7 @@ fn near_objects_occlude_and_blurred_edges_are_soft() {
     let one_group = BlendSettings {
         mode: BlendMode::Grouped,
         group_tolerance_d: 10.0,
-        wide_field: true,
+        ..BlendSettings::default()
     };
     let splat = splat_with(&grid, BlendSettings::default(), &a);
     let refr = reference::render(&a.input(), &exact);

@@ -37,6 +37,7 @@ impl Frame {
             depth_m: &self.depth,
             fov_y_deg: 10.0,
             hidden_layers: &[],
+            mixed: None,
         }
     }
 }
@@ -445,6 +446,7 @@ fn splat_through_host(
         depth_m: &frame.depth_m,
         fov_y_deg: state.camera.fov_y_deg,
         hidden_layers: &[],
+        mixed: None,
     };
     splatter.render(&input, scene_view(), false).unwrap()
 }

@@ -60,6 +60,7 @@ fn splat_host(
         depth_m: &visible.depth_m,
         fov_y_deg: state.camera.fov_y_deg,
         hidden_layers: &hidden,
+        mixed: None,
     };
     splatter.render(&input, view(), false).unwrap()
 }

@@ -103,6 +103,7 @@ fn render_on(
     let reference = with_reference.then(|| {
         let single = FrameInput {
             hidden_layers: &[],
+            mixed: None,
             ..*input
         };
         renderer
@@ -130,6 +131,7 @@ fn one_layer<'a>(
         depth_m: depth,
         fov_y_deg: fov,
         hidden_layers: &[],
+        mixed: None,
     }
 }
 
@@ -538,6 +540,7 @@ fn case3_an_in_focus_wall_past_a_near_edge() {
     let one = one_layer((w, h, fov), &color0, &depth0);
     let two = FrameInput {
         hidden_layers: &hidden,
+        mixed: None,
         ..one
     };
     let single = render(
@@ -1064,6 +1067,7 @@ fn case9_a_defocused_wall_behind_an_in_focus_edge() {
     let one = one_layer((w, h, fov), &color0, &depth0);
     let two = FrameInput {
         hidden_layers: &hidden,
+        mixed: None,
         ..one
     };
     let single = render(

@@ -120,6 +120,7 @@ fn splat_focused(frames: &[Frame], focus_d: f64, pupil_visibility: bool) -> Vec<
         depth_m: &frames[0].depth_m,
         fov_y_deg: FOV,
         hidden_layers: &hidden,
+        mixed: None,
     };
     let view = ViewState {
         pupil_mm: pupil_mm(),

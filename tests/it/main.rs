@@ -37,6 +37,7 @@ mod layered_inputs;
 mod layers;
 mod metrics;
 mod metrics_small;
+mod mixed_pixels;
 mod object_axis;
 mod object_knots;
 mod off_axis_kernels;

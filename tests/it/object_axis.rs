@@ -93,6 +93,7 @@ fn at_the_pixel_scale_of_4k_the_layer_kernels_hold() {
         depth_m: &depth,
         fov_y_deg: FOV_Y_DEG,
         hidden_layers: &[],
+        mixed: None,
     };
     let state = EyeState {
         focus_d: 0.5,

@@ -88,6 +88,7 @@ fn a_wall_across_the_field_matches_the_traced_eye_without_seams() {
         depth_m: &depth,
         fov_y_deg: FOV_Y_DEG,
         hidden_layers: &[],
+        mixed: None,
     };
     let state = EyeState {
         focus_d: 0.0,

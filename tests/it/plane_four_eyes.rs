@@ -90,6 +90,7 @@ fn a_plane_through_the_four_eyes_is_its_convolution() {
                 depth_m: &depth,
                 fov_y_deg: FOV_Y_DEG,
                 hidden_layers: &[],
+                mixed: None,
             };
             let eye = resolve(name).unwrap().eye;
             let range = dioptre_range(&depth, W as u32, H as u32, FOV_Y_DEG);

@@ -35,6 +35,7 @@ fn slices_are_finite_and_clearly_worse_than_splatting() {
         depth_m: &depth,
         fov_y_deg: 60.0,
         hidden_layers: &[],
+        mixed: None,
     };
     let eye = SyntheticEye::new(0.4, 3.0);
     let objects = DioptreAxis::spanning(0.0, 4.0, 33);
@@ -111,6 +112,7 @@ fn the_blend_is_a_convolution_at_equal_depth() {
         depth_m: &depth,
         fov_y_deg: 2.0,
         hidden_layers: &[],
+        mixed: None,
     };
     let mut previous = f64::INFINITY;
     for px_per_d in [1.0, 3.0, 6.0] {
@@ -169,6 +171,7 @@ fn slices_are_deterministic() {
         depth_m: &depth,
         fov_y_deg: 10.0,
         hidden_layers: &[],
+        mixed: None,
     };
     let exact = ExactSynthetic {
         eye: SyntheticEye::new(0.5, 3.0),

@@ -44,6 +44,7 @@ impl Scene {
             depth_m: &self.depth,
             fov_y_deg: 60.0,
             hidden_layers: &[],
+            mixed: None,
         }
     }
 }

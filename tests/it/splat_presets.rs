@@ -58,6 +58,7 @@ pub(crate) fn layered_input<'a>(color: &'a [[f32; 4]], depth: &'a [f32]) -> Fram
         depth_m: depth,
         fov_y_deg: FOV_Y_DEG,
         hidden_layers: &[],
+        mixed: None,
     }
 }
 

@@ -86,6 +86,7 @@ fn real_kernels_splat_like_the_ground_truth() {
         depth_m: &depth,
         fov_y_deg: 3.0,
         hidden_layers: &[],
+        mixed: None,
     };
     let truth = reference::render(&input, &exact);
     let ctx = common::gpu();

@@ -37,6 +37,7 @@ fn a_flat_wall_has_the_vergence_of_its_ray_length() {
         depth_m: &depth,
         fov_y_deg: fov,
         hidden_layers: &[],
+        mixed: None,
     };
     let (lo, hi) = dioptre_range(&depth, w, h, fov);
     let tan_half = (0.5 * fov).to_radians().tan();
@@ -142,6 +143,7 @@ fn equal_angular_blur_grows_with_the_pinhole_scale() {
         depth_m: &depth,
         fov_y_deg: fov,
         hidden_layers: &[],
+        mixed: None,
     };
     let eye = SyntheticEye::new(0.0, 3.0); // about 12 px of blur at 4 D
     let objects = DioptreAxis::spanning(0.0, 6.0, 13);

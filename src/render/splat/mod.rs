@@ -80,6 +80,46 @@ pub struct FrameInput<'a> {
     /// The 2nd, 3rd, … surfaces along each pixel's ray (depth peeling, layered EXR), nearest
     /// first; infinite depth where a layer is empty. Empty: the visible surface only.
     pub hidden_layers: &'a [HiddenLayer<'a>],
+    /// Where a silhouette splits pixels between surfaces, what lies behind the visible one
+    /// (the rasteriser's samples, [`crate::render::Rasterizer::set_mixed_pixels`]); only the
+    /// reference reads it, and only with [`crate::render::EdgePixels::Split`]. None: every
+    /// pixel is one fragment of colour `color` at depth `depth_m`.
+    pub mixed: Option<MixedPixels<'a>>,
+}
+
+/// How silhouettes split a frame's pixels (issue 51, docs/validation.md "Mixed pixels"). A
+/// pixel a silhouette crosses shows the near surface in part of its area and what lies behind
+/// in the rest; one fragment of the mean colour at the near depth blurs the rest with the near
+/// surface's kernel and lets the near surface cover the whole pixel. Split, the pixel is two
+/// fragments: the near surface's colour with its share of the pixel, and the rest's colour at
+/// the rest's depth with the remainder. `color` stays the pixel's mean colour, so a method
+/// that does not split reads the frame as before. Measured against the multi-view truth, the
+/// split moved the reference's edge band away from it, so no method splits by default.
+#[derive(Clone, Copy, Debug)]
+pub struct MixedPixels<'a> {
+    /// rgb: the mean colour of the samples behind the near surface's depth group; a: that
+    /// group's share of the pixel (1 where the pixel shows one surface).
+    pub rest: &'a [[f32; 4]],
+    /// The nearest distance along the view axis among those samples (m); +∞ where none.
+    pub rest_depth_m: &'a [f32],
+}
+
+impl MixedPixels<'_> {
+    /// The near surface's share of pixel `i` (0 < share ≤ 1).
+    pub fn share(&self, i: usize) -> f32 {
+        self.rest[i][3].clamp(0.0, 1.0)
+    }
+
+    /// The near surface's own colour at pixel `i`, given the pixel's mean `mean`: the mean
+    /// with the rest's part taken out.
+    pub fn near_color(&self, i: usize, mean: [f32; 4]) -> [f32; 3] {
+        let a = self.share(i);
+        if a >= 1.0 || a <= 0.0 {
+            return [mean[0], mean[1], mean[2]];
+        }
+        let r = self.rest[i];
+        [0, 1, 2].map(|c| ((mean[c] - (1.0 - a) * r[c]) / a).max(0.0))
+    }
 }
 
 /// One hidden depth layer of a frame: the same layout as the visible one.
