@@ -12,7 +12,8 @@ use super::Cli;
 use crate::eye::Eye;
 use crate::gpu::Context;
 use crate::image_io::{self, ImageRgba, Tonemap};
-use crate::render::binocular::{self, PairRequest, Yoke, SIDES};
+use crate::render::binocular::{self, FilePairRequest, PairRequest, Yoke, SIDES};
+use crate::render::frame::HostFrame;
 use crate::render::frame::Method;
 use crate::render::frame_plan::Correction;
 use crate::render::live::{LiveOptions, LiveRenderer};
@@ -43,6 +44,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
             ("--ipd-mm", args.ipd_mm.is_some()),
             ("--stereo", args.stereo.is_some()),
             ("--correct-right", args.correct_right.is_some()),
+            ("--color-right", args.color_right.is_some()),
         ];
         if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
             return Err(Error::input(format!(
@@ -50,11 +52,6 @@ pub fn check(args: &RenderArgs) -> Result<()> {
             )));
         }
         return Ok(());
-    }
-    if args.color.is_some() {
-        return Err(Error::input(
-            "--binocular renders a scene from two eye positions; a --color frame has one view",
-        ));
     }
     if args.method != Method::Splat {
         return Err(Error::input("--binocular renders with --method splat"));
@@ -66,6 +63,12 @@ pub fn check(args: &RenderArgs) -> Result<()> {
     }
     if let Some(ipd) = args.ipd_mm {
         binocular::check_ipd_mm(ipd).map_err(Error::input)?;
+    }
+    if args.color.is_some() && args.ipd_mm.is_some() {
+        return Err(Error::input(
+            "--ipd-mm places the eyes in a scene; a stereo pair from files was rendered with its \
+             own camera separation",
+        ));
     }
     Ok(())
 }
@@ -89,9 +92,10 @@ struct EyeSummary {
     side: &'static str,
     eye: String,
     output: Option<String>,
-    position_m: [f64; 3],
-    yaw_deg: f64,
-    pitch_deg: f64,
+    /// Scene pairs only: where the eye sits and where it looks.
+    position_m: Option<[f64; 3]>,
+    yaw_deg: Option<f64>,
+    pitch_deg: Option<f64>,
     demand_d: f64,
     far_point_d: f64,
     accommodation_max_d: Option<f64>,
@@ -104,14 +108,16 @@ struct EyeSummary {
 
 #[derive(serde::Serialize)]
 struct Summary {
+    /// The scene's name, or the pair's files.
     scene: String,
     width: u32,
     height: u32,
-    ipd_mm: f64,
+    /// Scene pairs only (a file pair's camera separation is its renderer's).
+    ipd_mm: Option<f64>,
     fixation_m: Option<[f64; 3]>,
     fixation_from: String,
-    /// Angle between the two lines of sight (degrees).
-    vergence_deg: f64,
+    /// Angle between the two lines of sight (degrees; scene pairs only).
+    vergence_deg: Option<f64>,
     pupil_mm: f64,
     pupil_source: String,
     yoke: Yoke,
@@ -134,8 +140,6 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         .map(|s| super::render::load_eye(s))
         .collect::<Result<_>>()?;
     let ipd_mm = args.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM);
-    let name = args.scene.clone().unwrap_or_else(|| "primitives".into());
-    let scene = Arc::new(Scene::load(&name)?);
     if !(args.time.is_finite() && args.time >= 0.0) {
         return Err(Error::input(format!(
             "--time {} must be a non-negative number of seconds",
@@ -144,6 +148,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     }
     let correction = args.correction.correction();
     let base = LiveOptions {
+        focus: super::render::focus_asked(args)?,
         pupil_mm: args.pupil_mm,
         luminance_cdm2: args.luminance_cdm2,
         age: args.age,
@@ -152,6 +157,18 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         quality,
         correction,
         ..LiveOptions::default()
+    };
+    let corrections = [
+        base.correction.clone(),
+        Correction {
+            spectacle: args.correct_right.or(base.correction.spectacle),
+            ..base.correction.clone()
+        },
+    ];
+    // A stereo pair from files is read before anything is written or the GPU is started.
+    let files_in = match &args.color {
+        Some(color) => Some(file_pair(args, color)?),
+        None => None,
     };
     // Every file of the pair is checked writable before rendering, and kept only if all are
     // written.
@@ -164,30 +181,44 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     files.probe()?;
     let ctx = Context::new(&cli.context_options())?;
     let live = LiveRenderer::new(ctx, args.cache.dir(), 2);
-    let size = args
-        .size
-        .unwrap_or((scene.resolution[0], scene.resolution[1]));
-    let pair = binocular::render_pair(
-        &live,
-        &PairRequest {
-            scene: &scene,
-            eyes: [&eyes[0], &eyes[1]],
-            options: LiveOptions {
-                focus: super::render::focus_asked(args)?,
-                ..base.clone()
-            },
-            corrections: [
-                base.correction.clone(),
-                Correction {
-                    spectacle: args.correct_right.or(base.correction.spectacle),
-                    ..base.correction.clone()
+    let (name, size, pair) = match &files_in {
+        Some((frames, label, warnings)) => {
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+            let pair = binocular::render_file_pair(
+                &live,
+                &FilePairRequest {
+                    frames: [&frames[0], &frames[1]],
+                    eyes: [&eyes[0], &eyes[1]],
+                    options: base,
+                    corrections,
                 },
-            ],
-            size,
-            time_s: args.time,
-            ipd_m: ipd_mm * 1e-3,
-        },
-    )?;
+            )?;
+            (label.clone(), (frames[0].width, frames[0].height), pair)
+        }
+        None => {
+            let name = args.scene.clone().unwrap_or_else(|| "primitives".into());
+            let scene = Arc::new(Scene::load(&name)?);
+            let size = args
+                .size
+                .unwrap_or((scene.resolution[0], scene.resolution[1]));
+            let pair = binocular::render_pair(
+                &live,
+                &PairRequest {
+                    scene: &scene,
+                    eyes: [&eyes[0], &eyes[1]],
+                    options: base,
+                    corrections,
+                    size,
+                    time_s: args.time,
+                    ipd_m: ipd_mm * 1e-3,
+                },
+            )?;
+            (name, size, pair)
+        }
+    };
+    let pair = &pair;
     for w in &pair.warnings {
         eprintln!("warning: {w}");
     }
@@ -196,9 +227,9 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             side: SIDES[e],
             eye: specs[e].clone(),
             output: None,
-            position_m: pair.positions_m[e],
-            yaw_deg: pair.cameras[e].yaw_deg,
-            pitch_deg: pair.cameras[e].pitch_deg,
+            position_m: pair.geometry.map(|g| g.positions_m[e]),
+            yaw_deg: pair.geometry.map(|g| g.cameras[e].yaw_deg),
+            pitch_deg: pair.geometry.map(|g| g.cameras[e].pitch_deg),
             demand_d: pair.demand_d[e],
             far_point_d: pair.far_point_d[e],
             accommodation_max_d: pair.amplitude_d[e],
@@ -210,7 +241,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         })
         .collect();
     let frames = [&pair.frames[0].color, &pair.frames[1].color];
-    let (exposure_ev, cameras, yoke) = (pair.exposure_ev, pair.cameras, pair.yoke);
+    let (exposure_ev, geometry, yoke) = (pair.exposure_ev, pair.geometry, pair.yoke);
     write(args, stereo, size, &frames, exposure_ev, (&files, &paths))?;
     files.commit()?;
     let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
@@ -219,21 +250,24 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             s.output = Some(o.clone());
         }
     }
-    let lines_of_sight = cameras.map(|c| c.forward());
-    let cos = (0..3)
-        .map(|k| lines_of_sight[0][k] * lines_of_sight[1][k])
-        .sum::<f64>()
-        .clamp(-1.0, 1.0);
+    let vergence_deg = geometry.map(|g| {
+        let lines_of_sight = g.cameras.map(|c| c.forward());
+        let cos = (0..3)
+            .map(|k| lines_of_sight[0][k] * lines_of_sight[1][k])
+            .sum::<f64>()
+            .clamp(-1.0, 1.0);
+        cos.acos().to_degrees()
+    });
     let summary = Summary {
         scene: name,
         width: size.0,
         height: size.1,
-        ipd_mm,
+        ipd_mm: geometry.map(|g| g.ipd_m * 1e3),
         fixation_m: pair.fixation_m,
-        fixation_from: pair.fixation_from,
-        vergence_deg: cos.acos().to_degrees(),
+        fixation_from: pair.fixation_from.clone(),
+        vergence_deg,
         pupil_mm: pair.pupil_mm,
-        pupil_source: pair.pupil_from,
+        pupil_source: pair.pupil_from.clone(),
         yoke,
         driver: SIDES[yoke.driver],
         stereo: match stereo {
@@ -253,6 +287,37 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The two frames of a stereo pair from files: `--color` and `--color-right` (each with its
+/// depth), or the `left` and `right` views of one multi-view EXR. Returns them, a label
+/// naming the files and the files' warnings (each naming its eye).
+fn file_pair(args: &RenderArgs, color: &Path) -> Result<([HostFrame; 2], String, Vec<String>)> {
+    let (left, right, label) = match &args.color_right {
+        Some(color_right) => (
+            super::render::file_input(args, color, args.depth.as_ref(), None)?,
+            super::render::file_input(args, color_right, args.depth_right.as_ref(), None)?,
+            format!("{} | {}", color.display(), color_right.display()),
+        ),
+        None => (
+            super::render::file_input(args, color, args.depth.as_ref(), Some("left"))?,
+            super::render::file_input(args, color, args.depth.as_ref(), Some("right"))?,
+            format!("{} (views left, right)", color.display()),
+        ),
+    };
+    let (l, r) = (&left.frame, &right.frame);
+    if (l.width, l.height) != (r.width, r.height) {
+        return Err(Error::input(format!(
+            "the left frame ({}) is {}×{} and the right ({}) {}×{}: a stereo pair needs one \
+             size",
+            left.label, l.width, l.height, right.label, r.width, r.height
+        )));
+    }
+    let mut warnings = Vec::new();
+    for (side, input) in SIDES.iter().zip([&left, &right]) {
+        warnings.extend(input.warnings.iter().map(|w| format!("{side} eye: {w}")));
+    }
+    Ok(([left.frame, right.frame], label, warnings))
+}
+
 fn distance(d: f64) -> String {
     if d > 0.0 {
         format!("{:.3} m ({d:.2} D)", 1.0 / d)
@@ -262,21 +327,35 @@ fn distance(d: f64) -> String {
 }
 
 fn print(s: &Summary) {
-    println!(
-        "wrote {} ({}×{}, scene {}, two eyes {:.1} mm apart converging {:.2}° on {} from {}; \
-         pupils {:.2} mm from {})",
-        s.outputs.join(", "),
-        s.width,
-        s.height,
-        s.scene,
-        s.ipd_mm,
-        s.vergence_deg,
-        s.fixation_m
-            .map_or("infinity".into(), |_| distance(s.eyes[0].demand_d)),
-        s.fixation_from,
-        s.pupil_mm,
-        s.pupil_source,
-    );
+    match (s.ipd_mm, s.vergence_deg) {
+        (Some(ipd_mm), Some(vergence_deg)) => println!(
+            "wrote {} ({}×{}, scene {}, two eyes {:.1} mm apart converging {:.2}° on {} from {}; \
+             pupils {:.2} mm from {})",
+            s.outputs.join(", "),
+            s.width,
+            s.height,
+            s.scene,
+            ipd_mm,
+            vergence_deg,
+            s.fixation_m
+                .map_or("infinity".into(), |_| distance(s.eyes[0].demand_d)),
+            s.fixation_from,
+            s.pupil_mm,
+            s.pupil_source,
+        ),
+        _ => println!(
+            "wrote {} ({}×{}, stereo pair {}, both eyes fixating {} from {}; pupils {:.2} mm \
+             from {})",
+            s.outputs.join(", "),
+            s.width,
+            s.height,
+            s.scene,
+            distance(s.eyes[0].demand_d),
+            s.fixation_from,
+            s.pupil_mm,
+            s.pupil_source,
+        ),
+    }
     println!(
         "  accommodation {:.2} D, driven by the {} eye",
         s.yoke.accommodation_d, s.driver

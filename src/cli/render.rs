@@ -71,6 +71,14 @@ pub struct RenderArgs {
     /// Render NaN or infinite colour samples of --color as black instead of refusing the file.
     #[arg(long, requires = "color")]
     pub repair_nonfinite: bool,
+    /// With --binocular: the right eye's colour; --color (and --depth) is then the left's.
+    /// Without it, --binocular reads the `left` and `right` views of a multi-view --color EXR
+    /// (Blender's stereoscopy output). Both frames must have one size.
+    #[arg(long, value_name = "FILE", requires = "color")]
+    pub color_right: Option<PathBuf>,
+    /// With --color-right: the right eye's depth EXR (default: the --color-right EXR).
+    #[arg(long, value_name = "FILE.exr", requires = "color_right")]
+    pub depth_right: Option<PathBuf>,
     /// Eye: a preset (see `ocular eye list`) or an eye .toml file. With --eye-right, the left
     /// eye.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
@@ -335,6 +343,53 @@ pub(super) struct Input {
     pub(super) raster: Option<(Rasterizer, Scene, u32)>,
 }
 
+/// A frame from files: `color_path` (and `depth_path`, else the colour file's depth), one
+/// view of a multi-view EXR where `view` names it, read with the render options' choices.
+pub(super) fn file_input(
+    args: &RenderArgs,
+    color_path: &std::path::Path,
+    depth_path: Option<&std::path::PathBuf>,
+    view: Option<&str>,
+) -> Result<Input> {
+    let fov_y_deg = args.fov_y.ok_or_else(|| {
+        Error::input(
+            "--fov-y DEG is required with --color: the camera's vertical field of view in \
+             degrees (Blender shows the horizontal one for landscape frames: docs/inputs.md)",
+        )
+    })?;
+    check_fov(fov_y_deg)?;
+    let file = crate::inputs::load(&crate::inputs::FileInputOptions {
+        color: color_path.to_path_buf(),
+        depth: depth_path.cloned(),
+        color_layer: args.color_layer.clone(),
+        depth_channel: args.depth_channel.clone(),
+        depth_scale: args.depth_scale,
+        white_cdm2: args.white_cdm2,
+        repair_nonfinite: args.repair_nonfinite,
+        view: view.map(str::to_string),
+    })?;
+    Ok(Input {
+        frame: HostFrame {
+            width: file.color.width,
+            height: file.color.height,
+            color: file.color.pixels,
+            depth_m: file.depth_m,
+            fov_y_deg,
+            hidden: file
+                .hidden_layers
+                .into_iter()
+                .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
+                .collect(),
+            scene: SceneEye::default(),
+        },
+        label: file.color_source,
+        depth_source: Some(file.depth_source),
+        depth_report: Some(file.depth_report),
+        warnings: file.warnings,
+        raster: None,
+    })
+}
+
 fn load_input(
     cli: &Cli,
     args: &RenderArgs,
@@ -342,50 +397,15 @@ fn load_input(
     magnification: Option<[[f64; 2]; 2]>,
 ) -> Result<Input> {
     if let Some(color_path) = &args.color {
-        let fov_y_deg = args.fov_y.ok_or_else(|| {
-            Error::input(
-                "--fov-y DEG is required with --color: the camera's vertical field of view in \
-                 degrees (Blender shows the horizontal one for landscape frames: docs/inputs.md)",
-            )
-        })?;
-        check_fov(fov_y_deg)?;
-        let file = crate::inputs::load(&crate::inputs::FileInputOptions {
-            color: color_path.clone(),
-            depth: args.depth.clone(),
-            color_layer: args.color_layer.clone(),
-            depth_channel: args.depth_channel.clone(),
-            depth_scale: args.depth_scale,
-            white_cdm2: args.white_cdm2,
-            repair_nonfinite: args.repair_nonfinite,
-        })?;
-        let mut warnings = file.warnings;
+        let mut input = file_input(args, color_path, args.depth.as_ref(), None)?;
         if magnification.is_some() {
-            warnings.push(
+            input.warnings.push(
                 "--correct: the spectacle's magnification is applied to scenes; colour/depth files \
                  are shown at their own scale (its blur and aberrations are applied)"
                     .into(),
             );
         }
-        return Ok(Input {
-            frame: HostFrame {
-                width: file.color.width,
-                height: file.color.height,
-                color: file.color.pixels,
-                depth_m: file.depth_m,
-                fov_y_deg,
-                hidden: file
-                    .hidden_layers
-                    .into_iter()
-                    .take(args.layers.unwrap_or(u32::MAX).saturating_sub(1) as usize)
-                    .collect(),
-                scene: SceneEye::default(),
-            },
-            label: file.color_source,
-            depth_source: Some(file.depth_source),
-            depth_report: Some(file.depth_report),
-            warnings,
-            raster: None,
-        });
+        return Ok(input);
     }
     let _ = cli;
     let name = args

@@ -49,6 +49,11 @@ pub struct Channel {
 /// Every channel of every part of an EXR file.
 pub struct ExrChannels {
     pub channels: Vec<Channel>,
+    /// The views the file names (its `multiView` list, then its parts' `view` attributes),
+    /// without repeats; empty for a single-view file.
+    pub views: Vec<String>,
+    /// The view a channel without one belongs to: the first of the `multiView` list.
+    pub default_view: Option<String>,
 }
 
 fn file_error(path: &Path, message: impl std::fmt::Display) -> Error {
@@ -103,14 +108,22 @@ impl ExrChannels {
             .from_file(path)
             .map_err(|e| exr_error(path, e))?;
         let mut views: Vec<String> = Vec::new();
+        let mut default_view = None;
         for layer in &image.layer_data {
+            if let Some(list) = &layer.attributes.multi_view_names {
+                default_view = default_view.or_else(|| list.first().map(|v| v.to_string()));
+                views.extend(list.iter().map(|v| v.to_string()));
+            }
             if let Some(v) = &layer.attributes.view_name {
                 views.push(v.to_string());
             }
-            if let Some(list) = &layer.attributes.multi_view_names {
-                views.extend(list.iter().map(|v| v.to_string()));
-            }
         }
+        let mut seen = Vec::new();
+        views.retain(|v| {
+            let new = !seen.contains(v);
+            seen.push(v.clone());
+            new
+        });
         let mut channels = Vec::new();
         for layer in &image.layer_data {
             let part = layer
@@ -176,7 +189,46 @@ impl ExrChannels {
         if channels.is_empty() {
             return Err(file_error(path, "the EXR file holds no channels"));
         }
-        Ok(ExrChannels { channels })
+        Ok(ExrChannels {
+            channels,
+            views,
+            default_view,
+        })
+    }
+
+    /// The channels of view `name` alone: those the file places in it, and those with no view
+    /// when it is the file's default view (OpenEXR's multi-view convention). Errors name the
+    /// views the file holds.
+    pub fn only_view(self, path: &Path, name: &str) -> Result<ExrChannels> {
+        if !self.views.iter().any(|v| v == name) {
+            return Err(file_error(
+                path,
+                if self.views.is_empty() {
+                    format!(
+                        "has no views, so no {name} view (a stereo pair needs a multi-view EXR,                          such as Blender's stereoscopy output, or one file per eye)"
+                    )
+                } else {
+                    format!(
+                        "has no view named {name} (it holds {})",
+                        self.views.join(", ")
+                    )
+                },
+            ));
+        }
+        let default = self.default_view.as_deref() == Some(name);
+        let channels: Vec<Channel> = self
+            .channels
+            .into_iter()
+            .filter(|c| c.view == name || (default && c.view.is_empty()))
+            .collect();
+        if channels.is_empty() {
+            return Err(file_error(path, format!("view {name} holds no channels")));
+        }
+        Ok(ExrChannels {
+            channels,
+            views: vec![name.to_string()],
+            default_view: Some(name.to_string()),
+        })
     }
 
     fn names(&self) -> String {
@@ -395,7 +447,9 @@ impl ExrChannels {
             };
         }
         let is_depth = |c: &Channel| {
-            let bare = c.group.is_empty()
+            // a bare channel: no group, or only a view (`right.Z` in a multi-view file)
+            let bare = c.layer.is_empty()
+                && c.pass.is_empty()
                 && (c.channel.eq_ignore_ascii_case("z") || c.channel.eq_ignore_ascii_case("depth"));
             let pass = c.pass.eq_ignore_ascii_case("depth")
                 && self.channels.iter().filter(|o| o.group == c.group).count() == 1;

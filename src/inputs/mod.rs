@@ -33,6 +33,9 @@ pub struct FileInputOptions {
     pub white_cdm2: Option<f64>,
     /// Replace non-finite colour samples by 0 instead of refusing the file.
     pub repair_nonfinite: bool,
+    /// Of a multi-view EXR (OpenEXR's convention; Blender's stereoscopy output), read this
+    /// view alone (`left`, `right`); None: a single view.
+    pub view: Option<String>,
 }
 
 /// A colour + depth frame read from files, with where each came from.
@@ -97,12 +100,33 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
         ));
     }
     let mut warnings = Vec::new();
+    let in_view = |file: exr::ExrChannels, path: &Path| match &options.view {
+        Some(view) => file.only_view(path, view),
+        None => Ok(file),
+    };
     let color_exr = match color_kind {
-        Kind::Exr => Some(exr::ExrChannels::read(&options.color)?),
-        Kind::Picture => None,
+        Kind::Exr => Some(in_view(
+            exr::ExrChannels::read(&options.color)?,
+            &options.color,
+        )?),
+        Kind::Picture => {
+            if let Some(view) = &options.view {
+                return Err(Error::input(format!(
+                    "--color {}: a picture has one view, not a {view} view; a stereo pair from                      pictures is one file per eye",
+                    options.color.display()
+                )));
+            }
+            None
+        }
     };
     if let Some(file) = &color_exr {
         if let Some(layers) = layered::read_layers(&options.color, file)? {
+            if options.view.is_some() {
+                return Err(Error::file(
+                    &options.color,
+                    "a layered EXR with views is not read yet: give one layered file per eye",
+                ));
+            }
             return load_layered(options, layers);
         }
     }
@@ -170,7 +194,13 @@ pub fn load(options: &FileInputOptions) -> Result<FileInput> {
     let depth_file = match (&options.depth, &color_exr) {
         (None, Some(file)) => file,
         _ => {
-            separate = exr::ExrChannels::read(depth_path)?;
+            let file = exr::ExrChannels::read(depth_path)?;
+            // a depth file with views gives the same view; a single-view one is this view's
+            separate = if file.views.is_empty() {
+                file
+            } else {
+                in_view(file, depth_path)?
+            };
             &separate
         }
     };

@@ -195,11 +195,21 @@ pub struct PairRequest<'a> {
     pub ipd_m: f64,
 }
 
+/// Where the two eyes of a scene pair sit and look (a pair from files has the cameras its
+/// renderer gave it, unknown here).
+#[derive(Clone, Copy, Debug)]
+pub struct PairGeometry {
+    pub positions_m: [[f64; 3]; 2],
+    pub cameras: [Camera; 2],
+    /// Interpupillary distance (m).
+    pub ipd_m: f64,
+}
+
 /// Two frames and how they were made.
 pub struct Pair {
     pub frames: [LiveFrame; 2],
-    pub positions_m: [[f64; 3]; 2],
-    pub cameras: [Camera; 2],
+    /// None for a pair from files.
+    pub geometry: Option<PairGeometry>,
     pub fixation_m: Option<[f64; 3]>,
     pub fixation_from: String,
     pub demand_d: [f64; 2],
@@ -210,7 +220,8 @@ pub struct Pair {
     pub yoke: Yoke,
     pub pupil_mm: f64,
     pub pupil_from: String,
-    /// The exposure both frames are shown at: the camera frame's.
+    /// The exposure both frames are shown at: the camera frame's (a file pair: the left
+    /// frame's).
     pub exposure_ev: f32,
     pub warnings: Vec<String>,
 }
@@ -228,77 +239,165 @@ fn eye_limits(
     Ok((far, physiology.accommodation_max_d, physiology.correction))
 }
 
+/// What both kinds of pair share once the demands, the pupil and the exposure are known: each
+/// eye's limits, the one accommodation ([`yoke`]), and each eye's frame from `render` (eye
+/// index, its options with the yoked focus).
+struct Yoked<'a> {
+    eyes: [&'a Eye; 2],
+    options: &'a LiveOptions,
+    corrections: &'a [Correction; 2],
+    demand_d: [f64; 2],
+    pupil: (f64, String),
+    exposure_ev: f32,
+}
+
+impl Yoked<'_> {
+    fn render(
+        self,
+        render: impl Fn(usize, &LiveOptions) -> Result<LiveFrame>,
+        geometry: Option<PairGeometry>,
+        (fixation_m, fixation_from): (Option<[f64; 3]>, String),
+        mut warnings: Vec<String>,
+    ) -> Result<Pair> {
+        let (pupil_mm, pupil_from) = self.pupil;
+        let options = [0, 1].map(|e| LiveOptions {
+            correction: self.corrections[e].clone(),
+            ..self.options.clone()
+        });
+        let limits = [
+            eye_limits(self.eyes[0], &options[0], pupil_mm)?,
+            eye_limits(self.eyes[1], &options[1], pupil_mm)?,
+        ];
+        let far_point_d = [limits[0].0, limits[1].0];
+        let amplitude_d = [limits[0].1, limits[1].1];
+        let yoke = yoke(self.demand_d, far_point_d, amplitude_d);
+        let one = |e: usize| {
+            render(
+                e,
+                &LiveOptions {
+                    focus: Some(FocusAsked::Dioptres(yoke.focus_d[e])),
+                    pupil_mm: Some(pupil_mm),
+                    luminance_cdm2: None,
+                    exposure_ev: Some(f64::from(self.exposure_ev)),
+                    ..options[e].clone()
+                },
+            )
+        };
+        let frames = [one(0)?, one(1)?];
+        for (e, f) in frames.iter().enumerate() {
+            warnings.extend(
+                f.report
+                    .warnings
+                    .iter()
+                    .map(|w| format!("{} eye: {w}", SIDES[e])),
+            );
+        }
+        let [l0, l1] = limits;
+        Ok(Pair {
+            frames,
+            geometry,
+            fixation_m,
+            fixation_from,
+            demand_d: self.demand_d,
+            far_point_d,
+            amplitude_d,
+            corrections: [l0.2, l1.2],
+            yoke,
+            pupil_mm,
+            pupil_from,
+            exposure_ev: self.exposure_ev,
+            warnings,
+        })
+    }
+}
+
+/// The exposure asked, else the frame's automatic one.
+fn exposure_of(o: &LiveOptions, frame: &HostFrame) -> f32 {
+    o.exposure_ev.map_or_else(
+        || crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color),
+        |ev| ev as f32,
+    )
+}
+
 /// Renders `r` through both eyes: the fixation and the shared pupil and exposure from the
 /// camera's own frame, the eyes converged on the fixation, one accommodation ([`yoke`]).
 pub fn render_pair(live: &LiveRenderer, r: &PairRequest<'_>) -> Result<Pair> {
     let scene = SceneArg::Loaded(r.scene);
     let camera = r.scene.at_time(r.time_s).camera;
-    let (centre, mut warnings) = live.scene_frame(scene, None, Some(r.size), r.time_s)?;
-    let (fixation_m, fixation_from) = fixation(&camera, &centre, r.options.focus)?;
-    // One pupil for both (the consensual reflex), from the light the camera sees.
-    let (pupil_mm, pupil_from) = live::pupil_diameter(&r.options, &centre)?;
-    let exposure_ev = r.options.exposure_ev.map_or_else(
-        || crate::image_io::Tonemap::auto_exposure_ev_of(&centre.color),
-        |ev| ev as f32,
-    );
+    let (centre, warnings) = live.scene_frame(scene, None, Some(r.size), r.time_s)?;
+    let fixation = fixation(&camera, &centre, r.options.focus)?;
     let positions_m = eye_positions(&camera, r.ipd_m);
-    let cameras = eye_cameras(&camera, r.ipd_m, fixation_m);
-    let demand_d = demands_d(&positions_m, fixation_m);
-    let options = [0, 1].map(|e| LiveOptions {
-        correction: r.corrections[e].clone(),
-        ..r.options.clone()
-    });
-    let limits = [
-        eye_limits(r.eyes[0], &options[0], pupil_mm)?,
-        eye_limits(r.eyes[1], &options[1], pupil_mm)?,
-    ];
-    let far_point_d = [limits[0].0, limits[1].0];
-    let amplitude_d = [limits[0].1, limits[1].1];
-    let yoke = yoke(demand_d, far_point_d, amplitude_d);
-    let render = |e: usize| -> Result<LiveFrame> {
-        let o = LiveOptions {
-            focus: Some(FocusAsked::Dioptres(yoke.focus_d[e])),
-            pupil_mm: Some(pupil_mm),
-            luminance_cdm2: None,
-            exposure_ev: Some(f64::from(exposure_ev)),
-            ..options[e].clone()
-        };
-        let (frame, _) = live.render_scene_from(
-            scene,
-            r.eyes[e],
-            &o,
-            Some(r.size),
-            r.time_s,
-            Some(cameras[e]),
-        )?;
-        Ok(frame)
-    };
-    let frames = [render(0)?, render(1)?];
-    for (e, f) in frames.iter().enumerate() {
-        warnings.extend(
-            f.report
-                .warnings
-                .iter()
-                .map(|w| format!("{} eye: {w}", SIDES[e])),
-        );
+    let cameras = eye_cameras(&camera, r.ipd_m, fixation.0);
+    Yoked {
+        eyes: r.eyes,
+        options: &r.options,
+        corrections: &r.corrections,
+        demand_d: demands_d(&positions_m, fixation.0),
+        // One pupil for both (the consensual reflex), from the light the camera sees.
+        pupil: live::pupil_diameter(&r.options, &centre)?,
+        exposure_ev: exposure_of(&r.options, &centre),
     }
-    let [l0, l1] = limits;
-    Ok(Pair {
-        frames,
-        positions_m,
-        cameras,
-        fixation_m,
-        fixation_from,
-        demand_d,
-        far_point_d,
-        amplitude_d,
-        corrections: [l0.2, l1.2],
-        yoke,
-        pupil_mm,
-        pupil_from,
-        exposure_ev,
+    .render(
+        |e, o| {
+            live.render_scene_from(
+                scene,
+                r.eyes[e],
+                o,
+                Some(r.size),
+                r.time_s,
+                Some(cameras[e]),
+            )
+            .map(|(frame, _)| frame)
+        },
+        Some(PairGeometry {
+            positions_m,
+            cameras,
+            ipd_m: r.ipd_m,
+        }),
+        fixation,
         warnings,
-    })
+    )
+}
+
+/// A stereo pair rendered elsewhere (Blender's stereoscopy output, or one colour/depth pair
+/// per eye): each eye sees its own frame.
+pub struct FilePairRequest<'a> {
+    /// Left, right: one size.
+    pub frames: [&'a HostFrame; 2],
+    pub eyes: [&'a Eye; 2],
+    /// As [`PairRequest::options`]; the focus asked names a pixel or distance of the left
+    /// frame.
+    pub options: LiveOptions,
+    pub corrections: [Correction; 2],
+}
+
+/// Renders a pair from files. The cameras are the renderer's, so nothing here moves them: the
+/// fixation is resolved in the left frame (a pixel of it, or a distance), and both eyes demand
+/// its vergence (their distances to it differ by well under a percent at reading distance and
+/// beyond); pupil and exposure come from the left frame; accommodation is yoked as for scenes.
+pub fn render_file_pair(live: &LiveRenderer, r: &FilePairRequest<'_>) -> Result<Pair> {
+    let [left, right] = r.frames;
+    if (left.width, left.height) != (right.width, right.height) {
+        return Err(crate::Error::input(format!(
+            "the left frame is {}×{} and the right {}×{}: a stereo pair needs one size",
+            left.width, left.height, right.width, right.height
+        )));
+    }
+    let (focus_d, from) = left.focus_d(r.options.focus)?;
+    Yoked {
+        eyes: r.eyes,
+        options: &r.options,
+        corrections: &r.corrections,
+        demand_d: [focus_d; 2],
+        pupil: live::pupil_diameter(&r.options, left)?,
+        exposure_ev: exposure_of(&r.options, left),
+    }
+    .render(
+        |e, o| live.render(r.eyes[e], o, r.frames[e]),
+        None,
+        (None, format!("{from}, in the left frame")),
+        Vec::new(),
+    )
 }
 
 #[cfg(test)]

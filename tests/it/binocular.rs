@@ -6,7 +6,7 @@ use ocular::render::binocular::{eye_cameras, eye_positions, point_ahead, DEFAULT
 use ocular::render::Rasterizer;
 use ocular::scene::Scene;
 
-use crate::common::{finish, gpu, module_cache, ocular_run, temp_dir};
+use crate::common::{blender, finish, gpu, module_cache, ocular_run, temp_dir};
 
 const SIZE: (u32, u32) = (640, 360);
 const FOV_Y_DEG: f64 = 20.0;
@@ -230,12 +230,37 @@ fn a_monovision_pair_shares_one_accommodation() {
 
 #[test]
 fn binocular_options_are_checked() {
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 6] = [
         (&["render", "--ipd-mm", "63"], "--binocular"),
         (&["render", "--binocular", "--ipd-mm", "20"], "--ipd-mm"),
         (
+            &[
+                "render",
+                "--color",
+                "x.exr",
+                "--color-right",
+                "y.exr",
+                "--fov-y",
+                "40",
+            ],
+            "--binocular",
+        ),
+        (
+            &[
+                "render",
+                "--binocular",
+                "--color",
+                "x.exr",
+                "--fov-y",
+                "40",
+                "--ipd-mm",
+                "60",
+            ],
+            "--ipd-mm",
+        ),
+        (
             &["render", "--binocular", "--color", "x.exr", "--fov-y", "40"],
-            "--color",
+            "x.exr",
         ),
         (
             &["render", "--binocular", "--method", "reference"],
@@ -348,7 +373,7 @@ fn monovision_frames_are_sharp_where_each_eye_drives_and_independent_eyes_would_
         // near it, the other's is not.
         let quality = [0, 1].map(|e| {
             let mut state = scene.at_time(0.0);
-            state.camera = pair.cameras[e];
+            state.camera = pair.geometry.unwrap().cameras[e];
             let sharp = raster.render(live.context(), &state, 192, 108).unwrap();
             region_psnr(&pair.frames[e].color, &sharp.color, letter, scale)
         });
@@ -373,7 +398,7 @@ fn monovision_frames_are_sharp_where_each_eye_drives_and_independent_eyes_would_
                     &o,
                     Some((192, 108)),
                     0.0,
-                    Some(pair.cameras[other]),
+                    Some(pair.geometry.unwrap().cameras[other]),
                 )
                 .unwrap();
             f.color
@@ -484,7 +509,7 @@ fn glasses_of_different_powers_give_each_eye_its_image_size() {
     for e in 0..2 {
         let (x, _) = centroid(&pair.frames[e].color, SIZE.0);
         // each eye sees the marker from its own position (parallax, exact)
-        let tangent = (x_m - pair.positions_m[e][0]) / distance_m;
+        let tangent = (x_m - pair.geometry.unwrap().positions_m[e][0]) / distance_m;
         let expected = focal * magnification[e] * tangent;
         offsets[e] = x - cx;
         assert!(
@@ -496,7 +521,8 @@ fn glasses_of_different_powers_give_each_eye_its_image_size() {
     }
     // The two images differ in size by the ratio of the magnifications (4.1 % here).
     let ratio = offsets[0] / offsets[1];
-    let parallax = (x_m - pair.positions_m[0][0]) / (x_m - pair.positions_m[1][0]);
+    let parallax = (x_m - pair.geometry.unwrap().positions_m[0][0])
+        / (x_m - pair.geometry.unwrap().positions_m[1][0]);
     let expected = magnification[0] / magnification[1] * parallax;
     assert!(
         (ratio / expected - 1.0).abs() < 0.002,
@@ -570,4 +596,166 @@ fn a_pair_is_written_as_two_files_side_by_side_or_as_an_anaglyph() {
             assert_eq!([a[0], a[1], a[2]], [l[0], r[1], r[2]], "at {x},{y}");
         }
     }
+}
+
+/// One view of a synthetic stereo pair: a near card (0.5 m) shifted by `shift` px over a
+/// textured wall at 3 m, as (R, G, B, depth) planes.
+fn stereo_view((w, h): (usize, usize), shift: usize) -> [Vec<f32>; 4] {
+    let mut planes: [Vec<f32>; 4] = Default::default();
+    for y in 0..h {
+        for x in 0..w {
+            let card = (20 + shift..44 + shift).contains(&x) && (12..36).contains(&y);
+            let (rgb, d) = if card {
+                ([30.0, 6.0, 4.0], 0.5)
+            } else {
+                let t = 10.0 + 8.0 * ((x as f32 * 0.7).sin() * (y as f32 * 0.5).cos());
+                ([t, t * 1.1, t * 0.9], 3.0)
+            };
+            for c in 0..3 {
+                planes[c].push(rgb[c]);
+            }
+            planes[3].push(d);
+        }
+    }
+    planes
+}
+
+fn exr_planes(prefix: &str, depth: &str, planes: &[Vec<f32>; 4]) -> Vec<blender::Plane> {
+    ["R", "G", "B"]
+        .iter()
+        .enumerate()
+        .map(|(c, n)| blender::plane(&format!("{prefix}{n}"), planes[c].clone()))
+        .chain([blender::plane(depth, planes[3].clone())])
+        .collect()
+}
+
+/// Blender's stereoscopy output and OpenEXR's single-part multi-view convention render into
+/// the same pair, to the bit, as the same views given one file per eye; views that disagree
+/// in size, or a file without views, are refused with one line.
+#[test]
+fn a_stereo_exr_renders_as_its_two_halves() {
+    use exr::prelude::*;
+    let dir = temp_dir("stereo");
+    let cache = module_cache();
+    let size = (64usize, 48usize);
+    let (left, right) = (stereo_view(size, 0), stereo_view(size, 3));
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    blender::write_single_part(&dir.join("left.exr"), size, exr_planes("", "Z", &left));
+    blender::write_single_part(&dir.join("right.exr"), size, exr_planes("", "Z", &right));
+    // Blender: one part per view, its channels named as in a mono multilayer file
+    blender::write_views(
+        &dir.join("blender.exr"),
+        size,
+        vec![
+            (
+                "left",
+                "left",
+                exr_planes("ViewLayer.Combined.", "ViewLayer.Depth.Z", &left),
+            ),
+            (
+                "right",
+                "right",
+                exr_planes("ViewLayer.Combined.", "ViewLayer.Depth.Z", &right),
+            ),
+        ],
+    );
+    // OpenEXR's single-part convention: the default (first) view's channels unprefixed
+    let mut planes = exr_planes("", "Z", &left);
+    planes.extend(exr_planes("right.", "right.Z", &right));
+    let list: Vec<AnyChannel<FlatSamples>> = planes
+        .into_iter()
+        .map(|p| AnyChannel::new(p.name.as_str(), FlatSamples::F32(p.values)))
+        .collect();
+    let attributes = LayerAttributes {
+        multi_view_names: Some(vec![Text::from("left"), Text::from("right")]),
+        ..Default::default()
+    };
+    Image::from_layer(Layer::new(
+        size,
+        attributes,
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(list.into()),
+    ))
+    .write()
+    .to_file(dir.join("views.exr"))
+    .unwrap();
+
+    let render = |inputs: &[&str], out: &str| {
+        let mut args = vec!["render", "--binocular", "--fov-y", "30"];
+        args.extend_from_slice(inputs);
+        let cache = cache.to_str().unwrap().to_string();
+        let out = path(out);
+        args.extend_from_slice(&[
+            "--eye",
+            "healthy",
+            "--eye-right",
+            "myopia",
+            "--focus-m",
+            "0.5",
+            "--pupil-mm",
+            "4",
+            "--quality",
+            "fast",
+            "--cache",
+            &cache,
+            "-o",
+            &out,
+        ]);
+        ocular_run(&args)
+    };
+    let (l, r) = (path("left.exr"), path("right.exr"));
+    let halves = render(&["--color", &l, "--color-right", &r], "halves.exr");
+    assert!(
+        halves.status.success(),
+        "{}",
+        String::from_utf8_lossy(&halves.stderr)
+    );
+    let bytes = |name: &str| std::fs::read(dir.join(name)).unwrap();
+    assert_ne!(
+        bytes("halves-left.exr"),
+        bytes("halves-right.exr"),
+        "each eye sees its own view"
+    );
+    for file in ["blender.exr", "views.exr"] {
+        let stem = file.trim_end_matches(".exr").to_string() + "-out.exr";
+        let out = render(&["--color", &path(file)], &stem);
+        assert!(
+            out.status.success(),
+            "{file}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for side in ["left", "right"] {
+            let got = stem.replace(".exr", &format!("-{side}.exr"));
+            assert!(
+                bytes(&got) == bytes(&format!("halves-{side}.exr")),
+                "{file}: the {side} eye's frame differs from its half's"
+            );
+        }
+    }
+    // refusals: a single-view file as a pair, and views of two sizes
+    let one = render(&["--color", &l], "one.exr");
+    assert_eq!(one.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&one.stderr);
+    assert!(
+        text.contains("has no views") && text.lines().count() == 1,
+        "{text}"
+    );
+    let small = stereo_view((32, 24), 0);
+    blender::write_single_part(
+        &dir.join("small.exr"),
+        (32, 24),
+        exr_planes("", "Z", &small),
+    );
+    let sizes = render(
+        &["--color", &l, "--color-right", &path("small.exr")],
+        "sizes.exr",
+    );
+    assert_eq!(sizes.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&sizes.stderr);
+    assert!(
+        text.contains("64×48") && text.contains("32×24") && text.lines().count() == 1,
+        "{text}"
+    );
+    assert!(!dir.join("sizes-left.exr").exists() && !dir.join("one-left.exr").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

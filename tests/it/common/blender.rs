@@ -171,5 +171,6 @@ pub fn options(color: &Path) -> FileInputOptions {
         depth_scale: 1.0,
         white_cdm2: None,
         repair_nonfinite: false,
+        view: None,
     }
 }
