@@ -40,6 +40,13 @@ pub struct SettingsIn {
     pub off_axis: bool,
     #[serde(default)]
     pub time_s: f64,
+    /// `a` is the left eye and `b` (or `a` again) the right of one binocular pair: two eyes at
+    /// their own positions, converged on the focus, sharing one accommodation.
+    #[serde(default)]
+    pub binocular: bool,
+    /// The pair's interpupillary distance (default 63 mm).
+    #[serde(default)]
+    pub ipd_mm: Option<f64>,
 }
 
 fn one() -> u32 {
@@ -146,6 +153,8 @@ pub struct ViewRequest {
     /// Options shared by the sides (their corrections are each side's own).
     pub options: LiveOptions,
     pub time_s: f64,
+    /// A binocular pair's interpupillary distance (mm): `sides` are then left and right.
+    pub binocular_ipd_mm: Option<f64>,
 }
 
 type Checked<T> = std::result::Result<T, String>;
@@ -298,6 +307,21 @@ impl ViewRequest {
         if let Some(b) = s.b {
             sides.push(check_side(b, catalog).map_err(|e| format!("second eye: {e}"))?);
         }
+        let binocular_ipd_mm = if s.binocular {
+            if sides.len() == 1 {
+                sides.push(sides[0].clone());
+            }
+            check_pair(&sides, s.off_axis)?;
+            Some(match s.ipd_mm {
+                Some(ipd) => crate::render::binocular::check_ipd_mm(ipd)?,
+                None => crate::render::binocular::DEFAULT_IPD_MM,
+            })
+        } else {
+            if s.ipd_mm.is_some() {
+                return Err("--ipd-mm applies to two eyes: choose the binocular pair".into());
+            }
+            None
+        };
         let focus = match s.focus {
             FocusIn::Scene => None,
             FocusIn::D { d } => {
@@ -371,23 +395,24 @@ impl ViewRequest {
                 correction: Correction::default(),
             },
             time_s: s.time_s,
+            binocular_ipd_mm,
         })
     }
 
     /// The `ocular render` command (after `ocular eye estimate` for a prescription) that
-    /// renders `side` of this view into `output`.
+    /// renders `side` of this view into `output` (a binocular pair: both eyes, into
+    /// OUTPUT-left and OUTPUT-right).
     pub fn command_line(&self, side: usize, catalog: &Catalog, output: &str) -> String {
         let s = &self.sides[side];
         let mut prefix = String::new();
-        let eye = match &s.eye {
+        let mut eye_word = |choice: &EyeChoice, file: &str| match choice {
             EyeChoice::Preset(p) => p.clone(),
             EyeChoice::File(f) => catalog
                 .eye_files
                 .get(f)
                 .map_or_else(|| f.clone(), |e| e.cli.clone()),
             EyeChoice::Rx { rx, pupil_mm } => {
-                let file = "eye-rx.toml";
-                prefix = format!(
+                prefix.push_str(&format!(
                     "{} && ",
                     shell_words(&[
                         "ocular",
@@ -400,10 +425,43 @@ impl ViewRequest {
                         "-o",
                         file,
                     ])
-                );
+                ));
                 file.to_string()
             }
         };
+        if let Some(ipd_mm) = self.binocular_ipd_mm {
+            let (left, right) = (&self.sides[0], &self.sides[1]);
+            let left_eye = eye_word(&left.eye, "eye-rx-left.toml");
+            let mut pair: Vec<String> = vec!["--binocular".into(), "--eye".into(), left_eye];
+            if right.eye != left.eye {
+                let right_eye = eye_word(&right.eye, "eye-rx-right.toml");
+                pair.extend(["--eye-right".into(), right_eye]);
+            }
+            let correction = if left.correction_cli.is_empty() {
+                &right.correction_cli
+            } else {
+                &left.correction_cli
+            };
+            pair.extend(correction.iter().cloned());
+            if let (Some(l), Some(r)) = (spectacle_rx(left), spectacle_rx(right)) {
+                if l != r {
+                    pair.extend(["--correct-right".into(), r.to_string()]);
+                }
+            }
+            if ipd_mm != crate::render::binocular::DEFAULT_IPD_MM {
+                pair.extend(["--ipd-mm".into(), format!("{ipd_mm}")]);
+            }
+            return format!("{prefix}{}", self.render_words(catalog, pair, output));
+        }
+        let eye = eye_word(&s.eye, "eye-rx.toml");
+        let mut words: Vec<String> = vec!["--eye".into(), eye];
+        words.extend(s.correction_cli.iter().cloned());
+        format!("{prefix}{}", self.render_words(catalog, words, output))
+    }
+
+    /// `ocular render` with this view's scene, size and shared options around `eye_words`
+    /// (the eyes and their corrections).
+    fn render_words(&self, catalog: &Catalog, eye_words: Vec<String>, output: &str) -> String {
         let scene = catalog
             .scenes
             .get(&self.scene)
@@ -416,10 +474,8 @@ impl ViewRequest {
             scene,
             "--size".into(),
             format!("{}x{}", self.size.0, self.size.1),
-            "--eye".into(),
-            eye,
         ];
-        words.extend(s.correction_cli.iter().cloned());
+        words.extend(eye_words);
         words.extend(["--age".into(), format!("{}", o.age)]);
         if self.time_s != 0.0 {
             words.extend(["--time".into(), format!("{}", self.time_s)]);
@@ -447,8 +503,52 @@ impl ViewRequest {
         }
         words.extend(["-o".into(), output.into()]);
         let refs: Vec<&str> = words.iter().map(String::as_str).collect();
-        format!("{prefix}{}", shell_words(&refs))
+        shell_words(&refs)
     }
+}
+
+/// A side's spectacle or contact lens prescription as typed (`--correct`'s value).
+fn spectacle_rx(side: &Side) -> Option<&str> {
+    let words = &side.correction_cli;
+    words
+        .iter()
+        .position(|w| w == "--correct")
+        .and_then(|i| words.get(i + 1))
+        .map(String::as_str)
+}
+
+/// What `ocular render --binocular` can express of two eyes' corrections: the right eye may
+/// have its own spectacle or contact lens prescription (`--correct-right`), of the left's
+/// kind and vertex distance; an IOL is the same in both.
+fn check_pair(sides: &[Side], off_axis: bool) -> Checked<()> {
+    if off_axis {
+        return Err("--binocular does not take --off-axis yet".into());
+    }
+    let (l, r) = (&sides[0].correction, &sides[1].correction);
+    if l.iol != r.iol {
+        return Err(
+            "a binocular pair takes one IOL for both eyes (a per-eye IOL is not built \
+                     yet)"
+                .into(),
+        );
+    }
+    let kind = |c: &Correction| (c.spectacle.is_some(), c.contact, c.vertex_mm);
+    let (kl, kr) = (kind(l), kind(r));
+    if kl.0 && kr.0 && (kl.1, kl.2) != (kr.1, kr.2) {
+        return Err(
+            "a binocular pair's lenses are of one kind and vertex distance: glasses at \
+                    one --vertex-mm, or contact lenses, for both eyes"
+                .into(),
+        );
+    }
+    if kl.0 != kr.0 {
+        return Err(
+            "give both eyes a lens in a binocular pair (a plano \"0\" for an eye that \
+                    needs none)"
+                .into(),
+        );
+    }
+    Ok(())
 }
 
 /// Words joined for a POSIX shell, each quoted where it needs it.

@@ -333,7 +333,8 @@ impl Worker {
                 Stage::Preview => preview_size,
                 Stage::Full => request.size,
             };
-            for (side, eye) in eyes.iter().enumerate() {
+            let scene = &self.catalog.scenes[&request.scene].scene;
+            let options = |side: usize| {
                 let mut o: LiveOptions = request.options.clone();
                 o.correction = request.sides[side].correction.clone();
                 if let (
@@ -346,14 +347,58 @@ impl Worker {
                         (y / 2).min(size.1 - 1),
                     ));
                 }
-                let scene = &self.catalog.scenes[&request.scene].scene;
-                let rendered = self.live.render_scene(
-                    SceneArg::Loaded(scene),
-                    eye,
-                    &o,
-                    Some(size),
-                    request.time_s,
-                );
+                o
+            };
+            // A binocular pair renders both eyes together (one accommodation); each eye's
+            // frame then goes out as its side.
+            let mut pair = match request.binocular_ipd_mm {
+                Some(ipd_mm) => {
+                    let rendered = crate::render::binocular::render_pair(
+                        &self.live,
+                        &crate::render::binocular::PairRequest {
+                            scene,
+                            eyes: [&eyes[0], &eyes[1]],
+                            options: options(0),
+                            corrections: [
+                                request.sides[0].correction.clone(),
+                                request.sides[1].correction.clone(),
+                            ],
+                            size,
+                            time_s: request.time_s,
+                            ipd_m: ipd_mm * 1e-3,
+                        },
+                    );
+                    match rendered {
+                        Ok(p) => {
+                            // the scene's own warnings; each frame's come with it below
+                            let scene_warnings: Vec<String> = p
+                                .warnings
+                                .iter()
+                                .filter(|w| {
+                                    !w.starts_with("left eye:") && !w.starts_with("right eye:")
+                                })
+                                .cloned()
+                                .collect();
+                            let [l, r] = p.frames;
+                            vec![(l, scene_warnings.clone()), (r, scene_warnings)]
+                        }
+                        Err(e) => return self.hub.send_error(id, seq, &e.to_string()),
+                    }
+                }
+                None => Vec::new(),
+            };
+            pair.reverse();
+            for (side, eye) in eyes.iter().enumerate() {
+                let rendered = match pair.pop() {
+                    Some(done) => Ok(done),
+                    None => self.live.render_scene(
+                        SceneArg::Loaded(scene),
+                        eye,
+                        &options(side),
+                        Some(size),
+                        request.time_s,
+                    ),
+                };
                 let (frame, mut warnings) = match rendered {
                     Ok(f) => f,
                     Err(e) => return self.hub.send_error(id, seq, &e.to_string()),

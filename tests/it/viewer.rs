@@ -388,3 +388,94 @@ fn the_command_line_it_gives_renders_the_same_frame() {
         "{stdout} vs {reached}"
     );
 }
+
+/// A binocular pair: both eyes' frames come back as two sides, and the one command line the
+/// page shows renders the same two frames (OUTPUT-left, OUTPUT-right) with `--binocular`.
+/// A lens on one eye only is refused in one line (the CLI's right eye takes the left's kind).
+#[test]
+fn a_binocular_pair_is_the_clis_pair() {
+    let s = server(&[]);
+    let mut ws = connect(s.port);
+    let settings = serde_json::json!({
+        "scene": "primitives", "size": [80, 45],
+        "a": {"eye": {"kind": "preset", "name": "healthy"},
+              "correction": {"kind": "glasses", "rx": "0"}},
+        "b": {"eye": {"kind": "preset", "name": "myopia"},
+              "correction": {"kind": "glasses", "rx": "-3"}},
+        "focus": {"mode": "d", "d": 1.5},
+        "pupil": {"mode": "mm", "mm": 4.0},
+        "age": 50, "quality": "fast", "binocular": true, "ipd_mm": 60
+    });
+    ws.send(render(1, settings)).unwrap();
+    let mut full: Vec<(serde_json::Value, Vec<u8>)> = Vec::new();
+    while full.len() < 2 {
+        let (h, png) = next_frame(&mut ws).unwrap();
+        assert_eq!(h["sides"], 2, "{h}");
+        if h["stage"] == "full" {
+            full.push((h, png));
+        }
+    }
+    let command = full[0].0["command"].as_str().unwrap().to_string();
+    assert_eq!(command, full[1].0["command"].as_str().unwrap());
+    assert!(
+        command.contains("--binocular")
+            && command.contains("--eye-right myopia")
+            && command.contains("--correct-right -3")
+            && command.contains("--ipd-mm 60"),
+        "{command}"
+    );
+    let dir = crate::common::temp_dir("binocular");
+    let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_ocular"))
+        .parent()
+        .unwrap();
+    let path = format!(
+        "{}:{}",
+        bin_dir.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("{command} --cache {}", module_cache().display()))
+        .current_dir(&dir)
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let decode = |bytes: &[u8]| image::load_from_memory(bytes).unwrap().to_rgb8();
+    for (h, png) in &full {
+        let side = h["side"].as_u64().unwrap() as usize;
+        let name = ["ocular-left.png", "ocular-right.png"][side];
+        let (ours, cli) = (decode(png), decode(&std::fs::read(dir.join(name)).unwrap()));
+        let worst = ours
+            .pixels()
+            .zip(cli.pixels())
+            .flat_map(|(a, b)| (0..3).map(move |c| (i16::from(a[c]) - i16::from(b[c])).abs()))
+            .max()
+            .unwrap();
+        assert!(
+            worst <= 1,
+            "side {side}: the viewer and its command differ by {worst}"
+        );
+    }
+    let (l, r) = (decode(&full[0].1), decode(&full[1].1));
+    assert_ne!(l, r, "two eyes, two frames");
+    // one eye with a lens and the other without: refused, the connection kept
+    let one_lens = serde_json::json!({
+        "scene": "primitives", "size": [80, 45],
+        "a": {"eye": {"kind": "preset", "name": "healthy"}},
+        "b": {"eye": {"kind": "preset", "name": "myopia"},
+              "correction": {"kind": "glasses", "rx": "-3"}},
+        "age": 50, "quality": "fast", "binocular": true
+    });
+    ws.send(render(2, one_lens)).unwrap();
+    let reply: serde_json::Value = serde_json::from_str(&text(&mut ws)).unwrap();
+    assert_eq!(reply["type"], "error", "{reply}");
+    assert!(
+        reply["message"].as_str().unwrap().contains("plano"),
+        "{reply}"
+    );
+}

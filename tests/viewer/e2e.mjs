@@ -106,6 +106,22 @@ try {
     check(magic.equals(Buffer.from([0x76, 0x2f, 0x31, 0x01])), `${d.suggestedFilename()} is an OpenEXR file`);
   }
 
+  // Two eyes: a lens on one eye only is refused (the CLI gives the right eye the left's kind of
+  // lens); a plano lens on the other makes the pair, and both frames come back as left, right.
+  await page.selectOption("#compare", "binocular");
+  await page.waitForFunction(() => /plano/.test(document.body.innerText), null, { timeout: 30000 });
+  check(true, "a lens on one eye of a pair is refused with the remedy");
+  const seqPair = (await page.evaluate(() => window.ocularViewer.seq)) + 1;
+  await page.selectOption("#eye-0-corr", "contact");
+  await page.fill("#eye-0-corr-rx", "0");
+  await page.press("#eye-0-corr-rx", "Enter");
+  await page.waitForFunction((s) => window.ocularViewer.fullSeq[1] >= s, seqPair, { timeout: 120000 });
+  const heading = await page.locator("#summary-1 h3").innerText();
+  check(heading === "Right", `the second frame is the right eye's (${heading})`);
+  const pairCommand = await page.locator("#command").innerText();
+  check(/--binocular .*--correct-right -1\.75/.test(pairCommand) && pairCommand.split("\n").length === 1,
+    `one command renders the pair: ${pairCommand}`);
+
   mkdirSync(dirname(screenshot), { recursive: true });
   await page.evaluate(() => { document.getElementById("controls").scrollTop = 0; });
   await page.screenshot({ path: screenshot });

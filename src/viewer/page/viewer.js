@@ -108,6 +108,11 @@ function settings() {
     off_axis: $("off-axis").checked,
   };
   if ($("compare").value !== "off") s.b = eyeSettings(1);
+  if ($("compare").value === "binocular") {
+    // one pair: both eyes converge on the focus and share one accommodation
+    s.binocular = true;
+    s.ipd_mm = Number($("ipd").value);
+  }
   return s;
 }
 
@@ -211,6 +216,12 @@ function summaryHtml(s, header) {
   return `<dl>${dl}</dl>${warn}`;
 }
 
+// "A"/"B" when comparing two eyes, "Left"/"Right" for a binocular pair.
+function sideName(side) {
+  const pair = $("compare").value === "binocular";
+  return pair ? (side === 0 ? "Left" : "Right") : (side === 0 ? "A" : "B");
+}
+
 function caption(side) {
   if ($("compare").value === "off") return "";
   const p = `eye-${side}`;
@@ -218,7 +229,7 @@ function caption(side) {
   const eye = kind === "preset" ? $(`${p}-preset`).value : kind === "file" ? $(`${p}-file`).value : `Rx ${$(`${p}-rx`).value}`;
   const c = $(`${p}-corr`).value;
   const corr = c === "none" ? "uncorrected" : c === "iol" ? `IOL ${$(`${p}-iol`).value}` : `${c} ${$(`${p}-corr-rx`).value}`;
-  return `${side === 0 ? "A" : "B"}: ${eye}, ${corr}`;
+  return `${sideName(side)}: ${eye}, ${corr}`;
 }
 
 async function onFrame(header, png) {
@@ -236,9 +247,11 @@ async function onFrame(header, png) {
   state.summaries[side] = header.summary;
   if (header.stage === "full") state.fullSeq[side] = header.seq;
   state.commands[side] = header.command;
-  $(`summary-${side}`).innerHTML = (header.sides > 1 ? `<h3>${side === 0 ? "A" : "B"}</h3>` : "") + summaryHtml(header.summary, header);
+  $(`summary-${side}`).innerHTML = (header.sides > 1 ? `<h3>${sideName(side)}</h3>` : "") + summaryHtml(header.summary, header);
   img.parentElement.querySelector("figcaption").textContent = caption(side);
-  $("command").textContent = state.commands[0] + (header.sides > 1 && state.commands[1] ? `\n${state.commands[1]}` : "");
+  // a binocular pair's two sides share one command
+  const second = header.sides > 1 && state.commands[1] && state.commands[1] !== state.commands[0];
+  $("command").textContent = state.commands[0] + (second ? `\n${state.commands[1]}` : "");
   requestAnimationFrame(() => {
     const l = state.latency[header.seq];
     if (l && side === header.sides - 1) l[header.stage] = performance.now() - l.sent;
@@ -310,6 +323,7 @@ function layout() {
   $("eye-b").hidden = mode === "off";
   $("summary-1").hidden = mode === "off";
   $("split").hidden = mode !== "split";
+  $("ipd-row").hidden = mode !== "binocular";
   splitAt();
 }
 
@@ -377,6 +391,7 @@ async function start() {
   });
   $("age").addEventListener("input", () => { $("age-value").textContent = $("age").value; changed(); });
   $("compare").addEventListener("change", () => { layout(); changed(); });
+  $("ipd").addEventListener("change", changed);
   $("split").addEventListener("input", splitAt);
   $("img-0").addEventListener("click", focusClick);
   $("img-1").addEventListener("click", focusClick);
