@@ -222,6 +222,34 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     for w in &pair.warnings {
         eprintln!("warning: {w}");
     }
+    let frames = [&pair.frames[0].color, &pair.frames[1].color];
+    write(
+        args,
+        stereo,
+        size,
+        &frames,
+        pair.exposure_ev,
+        (&files, &paths),
+    )?;
+    files.commit()?;
+    let summary = summarize(pair, &specs, name, size, (stereo, &paths), live.device());
+    if args.json {
+        println!("{}", super::eye::json(&summary)?);
+        return Ok(());
+    }
+    print(&summary);
+    Ok(())
+}
+
+/// What `--json` and the text summary say of a written pair.
+fn summarize(
+    pair: &binocular::Pair,
+    specs: &[String; 2],
+    name: String,
+    size: (u32, u32),
+    (stereo, paths): (StereoOutput, &[PathBuf]),
+    device: String,
+) -> Summary {
     let mut summaries: Vec<EyeSummary> = (0..2)
         .map(|e| EyeSummary {
             side: SIDES[e],
@@ -240,10 +268,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             seconds_kernels: pair.frames[e].report.seconds_kernels,
         })
         .collect();
-    let frames = [&pair.frames[0].color, &pair.frames[1].color];
-    let (exposure_ev, geometry, yoke) = (pair.exposure_ev, pair.geometry, pair.yoke);
-    write(args, stereo, size, &frames, exposure_ev, (&files, &paths))?;
-    files.commit()?;
+    let (geometry, yoke) = (pair.geometry, pair.yoke);
     let outputs: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
     if stereo == StereoOutput::Separate {
         for (s, o) in summaries.iter_mut().zip(&outputs) {
@@ -258,7 +283,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             .clamp(-1.0, 1.0);
         cos.acos().to_degrees()
     });
-    let summary = Summary {
+    Summary {
         scene: name,
         width: size.0,
         height: size.1,
@@ -277,14 +302,8 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         },
         outputs,
         eyes: summaries,
-        device: live.device(),
-    };
-    if args.json {
-        println!("{}", super::eye::json(&summary)?);
-        return Ok(());
+        device,
     }
-    print(&summary);
-    Ok(())
 }
 
 /// The two frames of a stereo pair from files: `--color` and `--color-right` (each with its
