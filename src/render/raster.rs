@@ -389,16 +389,18 @@ impl Rasterizer {
         let pixels = u64::from(width) * u64::from(height);
         self.targets = Some(Targets {
             depth: Buffer::new(ctx, "raster depth", pixels * 4, Residency::Device)?,
+            // a frame's worth only where mixed pixels are asked for (133 MB at 4K); else a
+            // placeholder the resolve binds and never writes
             rest: Buffer::new(
                 ctx,
                 "raster mixed-pixel rest",
-                pixels * 16,
+                if self.mixed_pixels { pixels * 16 } else { 16 },
                 Residency::Device,
             )?,
             rest_depth: Buffer::new(
                 ctx,
                 "raster mixed-pixel rest depth",
-                pixels * 4,
+                if self.mixed_pixels { pixels * 4 } else { 16 },
                 Residency::Device,
             )?,
             readback: None,
@@ -572,11 +574,23 @@ impl Rasterizer {
             let readback = |name: &str, bytes: u64| {
                 Buffer::new(ctx, name, pixels * bytes, Residency::Readback)
             };
+            // the rest's read-backs hold a frame only where mixed pixels are asked for
+            let rest_pixels = if targets.color_sampled { 1 } else { 0 };
             targets.readback = Some([
                 readback("raster colour read-back", 16)?,
                 readback("raster depth read-back", 4)?,
-                readback("raster rest read-back", 16)?,
-                readback("raster rest depth read-back", 4)?,
+                Buffer::new(
+                    ctx,
+                    "raster rest read-back",
+                    (pixels * 16 * rest_pixels).max(16),
+                    Residency::Readback,
+                )?,
+                Buffer::new(
+                    ctx,
+                    "raster rest depth read-back",
+                    (pixels * 4 * rest_pixels).max(16),
+                    Residency::Readback,
+                )?,
             ]);
         }
         let targets = self.targets.as_ref().expect("prepared");
