@@ -218,7 +218,6 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
             (name, size, pair)
         }
     };
-    let pair = &pair;
     for w in &pair.warnings {
         eprintln!("warning: {w}");
     }
@@ -232,7 +231,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         (&files, &paths),
     )?;
     files.commit()?;
-    let summary = summarize(pair, &specs, name, size, (stereo, &paths), live.device());
+    let summary = summarize(&pair, &specs, name, size, (stereo, &paths), live.device());
     if args.json {
         println!("{}", super::eye::json(&summary)?);
         return Ok(());

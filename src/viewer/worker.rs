@@ -351,7 +351,7 @@ impl Worker {
             };
             // A binocular pair renders both eyes together (one accommodation); each eye's
             // frame then goes out as its side.
-            let mut pair = match request.binocular_ipd_mm {
+            let pair = match request.binocular_ipd_mm {
                 Some(ipd_mm) => {
                     let rendered = crate::render::binocular::render_pair(
                         &self.live,
@@ -387,9 +387,9 @@ impl Worker {
                 }
                 None => Vec::new(),
             };
-            pair.reverse();
+            let mut pair = pair.into_iter();
             for (side, eye) in eyes.iter().enumerate() {
-                let rendered = match pair.pop() {
+                let rendered = match pair.next() {
                     Some(done) => Ok(done),
                     None => self.live.render_scene(
                         SceneArg::Loaded(scene),

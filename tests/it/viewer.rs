@@ -323,6 +323,32 @@ fn the_rate_and_the_number_of_clients_are_bounded() {
     );
 }
 
+/// Runs a command line the page gave as a user would, in a shell in `dir`, with this build's
+/// binary first on the PATH and the module's kernel cache; it must succeed.
+fn run_in_shell(command: &str, dir: &std::path::Path) -> std::process::Output {
+    let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_ocular"))
+        .parent()
+        .unwrap();
+    let path = format!(
+        "{}:{}",
+        bin_dir.display(),
+        std::env::var("PATH").unwrap_or_default()
+    );
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("{command} --cache {}", module_cache().display()))
+        .current_dir(dir)
+        .env("PATH", path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 #[test]
 fn the_command_line_it_gives_renders_the_same_frame() {
     let s = server(&[]);
@@ -344,28 +370,8 @@ fn the_command_line_it_gives_renders_the_same_frame() {
     };
     let command = header["command"].as_str().unwrap();
     assert!(command.starts_with("ocular render "), "{command}");
-    // Run it as a user would, in a shell, with this build's binary first on the PATH.
     let dir = crate::common::temp_dir("command");
-    let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_ocular"))
-        .parent()
-        .unwrap();
-    let path = format!(
-        "{}:{}",
-        bin_dir.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
-    let out = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("{command} --cache {}", module_cache().display()))
-        .current_dir(&dir)
-        .env("PATH", path)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = run_in_shell(command, &dir);
     let decode = |bytes: &[u8]| image::load_from_memory(bytes).unwrap().to_rgb8();
     let ours = decode(&png);
     let cli = decode(&std::fs::read(dir.join("ocular.png")).unwrap());
@@ -425,26 +431,7 @@ fn a_binocular_pair_is_the_clis_pair() {
         "{command}"
     );
     let dir = crate::common::temp_dir("binocular");
-    let bin_dir = std::path::Path::new(env!("CARGO_BIN_EXE_ocular"))
-        .parent()
-        .unwrap();
-    let path = format!(
-        "{}:{}",
-        bin_dir.display(),
-        std::env::var("PATH").unwrap_or_default()
-    );
-    let out = std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("{command} --cache {}", module_cache().display()))
-        .current_dir(&dir)
-        .env("PATH", path)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    run_in_shell(&command, &dir);
     let decode = |bytes: &[u8]| image::load_from_memory(bytes).unwrap().to_rgb8();
     for (h, png) in &full {
         let side = h["side"].as_u64().unwrap() as usize;
