@@ -194,6 +194,36 @@ impl KernelSet {
             .collect()
     }
 
+    /// Per object distance and channel, the radius of the uniform disc as high as the kernel's
+    /// highest texel at its natural radius: 1/√(π·peak), the peak taken of the kernel
+    /// normalised to unit sum. Averaging a block's colours moves a pixel by about the block's
+    /// colour spread times its area times the height of the kernel's rim where that rim cuts
+    /// the block (glsl/render/splat/merge.comp), and the highest rim a kernel has is its peak.
+    /// For a defocus disc it is the natural radius, as the core radius is; for a line focus
+    /// (astigmatism), a bright caustic ring or a sharp core it is smaller than the core radius,
+    /// which counts a line of length L as a disc of diameter about L/√2 and so puts its height
+    /// several times too low.
+    pub fn peak_radii_px(&self) -> Vec<[f32; 3]> {
+        let levels = level_count(self.max_radius_px);
+        (0..self.objects.count)
+            .map(|o| {
+                [0, 1, 2].map(|c| {
+                    let natural = f64::from(self.radius_px[o][c]);
+                    let level = (level_of_radius(natural).round() as u32).min(levels - 1);
+                    let (mut sum, mut peak) = (0.0f64, 0.0f64);
+                    for t in self.kernel(level, o) {
+                        sum += f64::from(t[c]);
+                        peak = peak.max(f64::from(t[c]));
+                    }
+                    if sum <= 0.0 || peak <= 0.0 || !sum.is_finite() {
+                        return 0.5;
+                    }
+                    (1.0 / (std::f64::consts::PI * peak / sum)).sqrt() as f32
+                })
+            })
+            .collect()
+    }
+
     /// Bytes of the texels as stored for the GPU (three f32 per texel).
     pub fn size_bytes(&self) -> u64 {
         self.texels.len() as u64 * 12

@@ -760,8 +760,13 @@ fn every_pass_matches_its_cpu_step() {
         .iter()
         .map(|c| c[0].min(c[1]).min(c[2]))
         .collect();
-    splat_cpu::merge_level(&frame, &mut cpu, &merge, &core, 2);
-    splat_cpu::merge_level(&frame, &mut cpu, &merge, &core, 4);
+    let peak: Vec<f32> = grid.sets[0]
+        .peak_radii_px()
+        .iter()
+        .map(|c| c[0].min(c[1]).min(c[2]))
+        .collect();
+    splat_cpu::merge_level(&frame, &mut cpu, &merge, &core, &peak, 2);
+    splat_cpu::merge_level(&frame, &mut cpu, &merge, &core, &peak, 4);
     let merged = cpu.iter().filter(|f| f.size > 1).count();
     assert!(
         merged > 20,

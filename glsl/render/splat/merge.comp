@@ -21,7 +21,8 @@ layout(push_constant) uniform MergePush {
     float scale_error_px;
 } push;
 
-// Per object distance: natural radius per channel (xyz) and the smallest core radius (w).
+// Per object distance o: natural radius per channel (xyz) and the smallest core radius (w) at
+// radii[o]; the smallest peak radius over the channels at radii[object_count + o].x.
 layout(std430, binding = 0) readonly buffer Radii { vec4 radii[]; };
 FRAGMENT_BUFFERS(1, 2, 3, 4, )
 FRAGMENT_LOAD
@@ -32,6 +33,14 @@ float core_radius(Fragment f) {
     uint i0 = uint(floor(f.index));
     uint i1 = min(i0 + 1u, frame.object_count - 1u);
     return mix(radii[i0].w, radii[i1].w, f.index - float(i0));
+}
+
+// Peak radius (1/√(π·peak)) of a fragment's kernels, interpolated like its radius.
+float peak_radius(Fragment f) {
+    uint i0 = uint(floor(f.index));
+    uint i1 = min(i0 + 1u, frame.object_count - 1u);
+    uint n = frame.object_count;
+    return mix(radii[n + i0].x, radii[n + i1].x, f.index - float(i0));
 }
 
 float min3(vec3 v) { return min(v.x, min(v.y, v.z)); }
@@ -60,18 +69,23 @@ void main() {
     // How blurred the block is: its kernels' smallest core radius, not their full extent (a
     // PSF with a sharp core and a wide flare must not merge: averaging would smear the core).
     float r_min = 1e30;
+    float r_peak = 1e30;
     for (int k = 0; k < 4; k++) {
         r_min = min(r_min, min(min3(f[k].radius), core_radius(f[k])));
+        r_peak = min(r_peak, peak_radius(f[k]));
     }
     // Three conditions, each a bound on what averaging the block changes. Its pixels keep
     // their kernel (the block reads the kernel summed over its pixels, below), so what merging
     // averages is their colours and depths: (1) the block is no wider than the blur allows,
     // s ≤ r / k (`blur_per_block`, 0: any side) and r at least the minimum radius;
-    // (2) colours: a kernel's rim (height about 1/(πr²)) crossing the block splits it, and the
-    // part inside carries its own colour, not the block's mean; with children whose colours
-    // differ by Δc that misplaces about Δc·s²/4 of colour, so the pixel moves by about
-    // Δc·(s/r)²/(4π). A smooth gradient cancels around the rim; a step does not. The block
-    // merges when that is at most the error budget ε (`merge_color_error`). (3) the depths'
+    // (2) colours: a kernel's rim crossing the block splits it, and the part inside carries
+    // its own colour, not the block's mean; with children whose colours differ by Δc that
+    // misplaces about Δc·s²/4 of colour, so the pixel moves by about Δc·s²·h/4, h the rim's
+    // height: at most the kernel's peak, 1/(π·r_peak²) (r_peak, the peak radius, is the
+    // natural radius for a defocus disc and smaller for a line focus, a caustic ring or a
+    // sharp core). A smooth gradient cancels around the rim; a step does not. The block
+    // merges when Δc·(s/r_peak)²/(4π) is at most the error budget ε (`merge_color_error`).
+    // (3) the depths'
     // summed spread within its tolerance per pixel of blur, and the whole block in one depth
     // group of the blend, so the merged fragment joins the group its pixels would have.
     if (r_min < max(frame.merge_min_radius, push.blur_per_block * float(size))) {
@@ -99,7 +113,7 @@ void main() {
     if (hi - lo > frame.group_tolerance_d) {
         return;
     }
-    float blur_per_side = r_min / float(size);
+    float blur_per_side = min(r_min, r_peak) / float(size);
     // 4π·ε·(r/s)²
     float color_bound = 12.566371 * frame.merge_color_error * blur_per_side * blur_per_side;
     float dioptre_spread = 0.0;

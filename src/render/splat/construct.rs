@@ -9,7 +9,7 @@ use super::{
 use crate::gpu::{
     Buffer, Context, Edge, GpuError, Image, ImageUsage, Residency, Sampler, TexelFormat,
 };
-use crate::psf::kernels::KernelGrid;
+use crate::psf::kernels::{KernelGrid, KernelSet};
 
 impl Splatter {
     /// Uploads `grid` and builds every pass. The grid stays resident on the GPU.
@@ -76,17 +76,8 @@ impl Splatter {
             .collect::<crate::gpu::GpuResult<Vec<_>>>()?;
         // Merging decides on the core radius: off axis the smallest over the nodes, so that a
         // block merges only where every node's kernel allows it.
-        let mut core_radii: Vec<Vec<[f32; 3]>> =
-            grid.sets.iter().map(|s| s.core_radii_px()).collect();
-        for g in nodes {
-            for (mine, theirs) in core_radii.iter_mut().zip(&g.sets) {
-                for (m, t) in mine.iter_mut().zip(theirs.core_radii_px()) {
-                    for c in 0..3 {
-                        m[c] = m[c].min(t[c]);
-                    }
-                }
-            }
-        }
+        let core_radii = smallest_over_nodes(&grid, nodes, KernelSet::core_radii_px);
+        let peak_radii = smallest_over_nodes(&grid, nodes, KernelSet::peak_radii_px);
         let texture = psf_texture::create_texture(ctx, layout.extent(), settings.texture_format)?;
         let field_table = field::FieldTable::new(ctx, field_axes.as_ref(), grid.objects.count)?;
         let atlas = Buffer::from_slice(ctx, "PSF texture atlas", &layout.atlas_words())?;
@@ -117,7 +108,7 @@ impl Splatter {
         let radii = Buffer::new(
             ctx,
             "object radii",
-            grid.objects.count as u64 * 16,
+            grid.objects.count as u64 * 32,
             Residency::Device,
         )?;
         Ok(Splatter {
@@ -140,12 +131,13 @@ impl Splatter {
             radii_staging: Buffer::new(
                 ctx,
                 "object radii staging",
-                grid.objects.count as u64 * 16,
+                grid.objects.count as u64 * 32,
                 Residency::Upload,
             )?,
             texture_blend: None,
             last_lists: None,
             core_radii,
+            peak_radii,
             frame: None,
             entries: None,
             passes: Passes::new(
@@ -282,4 +274,24 @@ impl Splatter {
     pub fn field_axes(&self) -> Option<&crate::psf::field::FieldAxes> {
         self.field_axes.as_ref()
     }
+}
+
+/// Per set and object distance, a per-kernel radius (`of`) at its smallest over the field nodes
+/// (on axis, the grid's own), so that a block merges only where every node's kernel allows it.
+fn smallest_over_nodes(
+    grid: &KernelGrid,
+    nodes: &[KernelGrid],
+    of: fn(&KernelSet) -> Vec<[f32; 3]>,
+) -> Vec<Vec<[f32; 3]>> {
+    let mut radii: Vec<Vec<[f32; 3]>> = grid.sets.iter().map(of).collect();
+    for g in nodes {
+        for (mine, theirs) in radii.iter_mut().zip(&g.sets) {
+            for (m, t) in mine.iter_mut().zip(of(theirs)) {
+                for c in 0..3 {
+                    m[c] = m[c].min(t[c]);
+                }
+            }
+        }
+    }
+    radii
 }

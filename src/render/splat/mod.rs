@@ -294,6 +294,8 @@ pub struct Splatter {
     last_lists: Option<(u64, u32)>,
     /// Per set, the core radius of every object's kernels (see `KernelSet::core_radii_px`).
     core_radii: Vec<Vec<[f32; 3]>>,
+    /// Per set, the peak radius of every object's kernels (see `KernelSet::peak_radii_px`).
+    peak_radii: Vec<Vec<[f32; 3]>>,
     frame: Option<FrameResources>,
     entries: Option<Buffer>,
     passes: Passes,
@@ -468,7 +470,15 @@ impl Splatter {
             .collect();
         // Inputs and radii go through persistent mapped buffers: no allocation per frame.
         let input_bytes = source.stage(&ctx, self.frame.as_mut().expect("ensured above"))?;
+        // After them, per object distance, the smallest peak radius over the channels (x),
+        // which bounds what averaging a block's colours can move (merge.comp).
+        let peak = self.grid.blend_per_object(&blend, &self.peak_radii);
+        let peaks: Vec<[f32; 4]> = peak
+            .iter()
+            .map(|p| [p[0].min(p[1]).min(p[2]), 0.0, 0.0, 0.0])
+            .collect();
         self.radii_staging.write_mapped(0, &radii)?;
+        self.radii_staging.write_mapped(radii.len(), &peaks)?;
         let table = self.field_table.contents(self.nodes(), &blend);
         self.field_table.staging.write_mapped(0, &table)?;
         let projection = crate::render::projection::Projection {
@@ -490,7 +500,7 @@ impl Splatter {
             .uniform
             .write_mapped(0, std::slice::from_ref(&params))?;
         let upload_bytes =
-            input_bytes + radii.len() as u64 * 16 + table.len() as u64 * 16 + FRAME_UNIFORM_BYTES;
+            input_bytes + radii.len() as u64 * 32 + table.len() as u64 * 16 + FRAME_UNIFORM_BYTES;
         let frame = self.frame.as_ref().expect("ensured above");
         let hidden = self.hidden_light(&params, &radii, view);
         let block = FrameBlock {

@@ -92,14 +92,16 @@ pub fn merge_level(
     fragments: &mut [Fragment],
     settings: &MergeSettings,
     core: &[f32],
+    peak: &[f32],
     size: u32,
 ) {
-    let core_of = |f: &Fragment| {
+    let at = |table: &[f32], f: &Fragment| {
         let i0 = f.index.floor() as usize;
-        let i1 = (i0 + 1).min(core.len() - 1);
+        let i1 = (i0 + 1).min(table.len() - 1);
         let t = f.index - i0 as f32;
-        core[i0] * (1.0 - t) + core[i1] * t
+        table[i0] * (1.0 - t) + table[i1] * t
     };
+    let core_of = |f: &Fragment| at(core, f);
     let child = size / 2;
     let w = frame.width;
     for by in 0..frame.height / size {
@@ -140,8 +142,10 @@ pub fn merge_level(
             if hi - lo > frame.group_tolerance_d {
                 continue;
             }
-            // 4π·ε·(r/s)², in merge.comp's order of operations.
-            let blur_per_side = r_min / size as f32;
+            // 4π·ε·(r/s)² with r the smaller of the blur and the kernels' peak radius, in
+            // merge.comp's order of operations.
+            let r_peak = f.iter().map(|x| at(peak, x)).fold(f32::INFINITY, f32::min);
+            let blur_per_side = r_min.min(r_peak) / size as f32;
             let color_bound = 12.566371f32
                 * (settings.color_error * settings.white)
                 * blur_per_side
