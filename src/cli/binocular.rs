@@ -260,7 +260,7 @@ fn summarize(
             demand_d: pair.demand_d[e],
             far_point_d: pair.far_point_d[e],
             accommodation_max_d: pair.amplitude_d[e],
-            focus_d: pair.frames[e].report.focus.actual_d,
+            focus_d: pair.yoke.focus_d[e],
             residual_defocus_d: pair.yoke.residual_d[e],
             correction: pair.corrections[e].clone(),
             seconds_render: pair.frames[e].report.seconds_render,
@@ -336,9 +336,13 @@ fn file_pair(args: &RenderArgs, color: &Path) -> Result<([HostFrame; 2], String,
     Ok(([left.frame, right.frame], label, warnings))
 }
 
+/// A vergence in words; a negative one (a hyperopic eye's far point, or its focus when it
+/// accommodates too little for infinity) lies beyond infinity.
 fn distance(d: f64) -> String {
     if d > 0.0 {
         format!("{:.3} m ({d:.2} D)", 1.0 / d)
+    } else if d < -1e-9 {
+        format!("beyond infinity ({d:.2} D)")
     } else {
         "infinity".into()
     }

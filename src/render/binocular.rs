@@ -15,7 +15,7 @@
 use std::sync::Arc;
 
 use crate::eye::Eye;
-use crate::render::focus::effective_focus;
+use crate::render::focus::signed_far_point_d;
 use crate::render::frame::HostFrame;
 use crate::render::frame_plan::{Correction, FocusAsked};
 use crate::render::live::{self, LiveFrame, LiveOptions, LiveRenderer, SceneArg};
@@ -111,18 +111,28 @@ pub struct Yoke {
     pub residual_d: [f64; 2],
 }
 
+/// Defocus (D) an eye's own target may keep and still count as seen sharp when the yoke picks
+/// the eye that drives: half the 0.25 D step refractions are prescribed in, below which a
+/// refractionist finds no better lens.
+pub const SHARP_ENOUGH_D: f64 = 0.125;
+
 /// The response a person makes to a target of `demand_d` (per eye, D) with eyes whose far
 /// points are `far_point_d` (D; 0 at infinity) and amplitudes `amplitude_d` (None: unlimited).
 ///
-/// Each eye alone would accommodate `demand − far point`, clamped to [0, amplitude]. The
-/// driver is the eye that reaches its target with the least accommodation; if neither
-/// reaches it, the eye left with the smaller defocus (the less accommodation on a tie).
+/// Each eye alone would accommodate `demand − far point` (a far point beyond infinity is
+/// negative, so a hyperopic eye spends accommodation even on a distant target), clamped to
+/// [0, amplitude]. The driver is the eye that sees its target sharp, within
+/// [`SHARP_ENOUGH_D`], with the least accommodation; if neither does, the eye left with the
+/// smaller defocus (the less accommodation on a tie). A slightly myopic eye that cannot relax
+/// the last 0.07 D to a far target therefore still drives against a hyperopic eye that
+/// would have to accommodate 1.7 D: the person keeps the image they get for free, as
+/// anisometropic hyperopes do (the more hyperopic eye is the one left blurred).
 pub fn yoke(demand_d: [f64; 2], far_point_d: [f64; 2], amplitude_d: [Option<f64>; 2]) -> Yoke {
     let amplitude = amplitude_d.map(|a| a.unwrap_or(f64::INFINITY).max(0.0));
     let wanted = [0, 1].map(|e| demand_d[e] - far_point_d[e]);
     let alone = [0, 1].map(|e| wanted[e].clamp(0.0, amplitude[e]));
     let miss = [0, 1].map(|e| (wanted[e] - alone[e]).abs());
-    let reaches = [0, 1].map(|e| miss[e] <= 1e-9);
+    let reaches = [0, 1].map(|e| miss[e] <= SHARP_ENOUGH_D + 1e-9);
     let driver = match reaches {
         [true, true] => usize::from(alone[1] < alone[0]),
         [true, false] => 0,
@@ -235,7 +245,9 @@ fn eye_limits(
 ) -> Result<(f64, Option<f64>, Option<String>)> {
     let (corrected, physiology) = live::physiology(eye, o)?;
     let settings = crate::psf::axes::KernelSettings::default();
-    let far = effective_focus(&corrected, 0.0, pupil_mm, &settings, "the far point")?.actual_d;
+    // Signed: a hyperopic eye's far point lies beyond infinity, and reaching even infinity
+    // spends some of its amplitude.
+    let far = signed_far_point_d(&corrected, pupil_mm, &settings)?;
     Ok((far, physiology.accommodation_max_d, physiology.correction))
 }
 
@@ -275,15 +287,28 @@ impl Yoked<'_> {
             render(
                 e,
                 &LiveOptions {
-                    focus: Some(FocusAsked::Dioptres(yoke.focus_d[e])),
                     pupil_mm: Some(pupil_mm),
                     luminance_cdm2: None,
                     exposure_ev: Some(f64::from(self.exposure_ev)),
-                    ..options[e].clone()
+                    ..at_accommodation(&options[e], far_point_d[e], yoke.focus_d[e])
                 },
             )
         };
-        let frames = [one(0)?, one(1)?];
+        let mut frames = [one(0)?, one(1)?];
+        for (e, f) in frames.iter_mut().enumerate() {
+            // Each frame reports the pair's state of its eye: the signed far point and the
+            // yoked focus (an eye rendered beyond infinity was rendered at infinity with its
+            // amplitude set to what it exerts; its own amplitude is the pair's).
+            let r = &mut f.report;
+            r.far_point_d = far_point_d[e];
+            r.focus.requested_d = self.demand_d[e];
+            r.focus.actual_d = yoke.focus_d[e];
+            if yoke.focus_d[e] < 0.0 {
+                r.focus.limit = crate::eye::FocusLimit::Reached;
+                r.focus.beyond_far_point = false;
+                r.physiology.accommodation_max_d = amplitude_d[e];
+            }
+        }
         for (e, f) in frames.iter().enumerate() {
             warnings.extend(
                 f.report
@@ -308,6 +333,27 @@ impl Yoked<'_> {
             exposure_ev: self.exposure_ev,
             warnings,
         })
+    }
+}
+
+/// `o` focused where the yoke puts the eye: at `focus_d` where that is a real point (the eye
+/// accommodates to it), else (a hyperopic eye that exerts less than it would need for infinity,
+/// its focus beyond infinity) at infinity with the amplitude limited to what it exerts,
+/// `focus_d − far_point_d`, so that the eye stops at exactly that accommodation.
+fn at_accommodation(o: &LiveOptions, far_point_d: f64, focus_d: f64) -> LiveOptions {
+    if focus_d >= 0.0 {
+        return LiveOptions {
+            focus: Some(FocusAsked::Dioptres(focus_d)),
+            ..o.clone()
+        };
+    }
+    LiveOptions {
+        focus: Some(FocusAsked::Dioptres(0.0)),
+        correction: Correction {
+            accommodation_max_d: Some((focus_d - far_point_d).max(0.0)),
+            ..o.correction.clone()
+        },
+        ..o.clone()
     }
 }
 
@@ -433,6 +479,27 @@ mod tests {
         // A target beyond both far points: both stay relaxed.
         let y = yoke([0.0; 2], [0.5, 1.0], [Some(3.0), None]);
         assert_eq!((y.accommodation_d, y.focus_d), (0.0, [0.5, 1.0]));
+    }
+
+    #[test]
+    fn a_hyperopic_eye_spends_accommodation_and_yields_to_an_eye_sharp_for_free() {
+        // Far point −1.5 D: a target at 0.1 D needs 1.6 D of it, and its amplitude bounds
+        // that. The left eye (far point 0.2 D) misses by 0.1 D relaxed: sharp enough, so it
+        // drives, and the right eye stays relaxed, focused beyond infinity.
+        let y = yoke([0.1; 2], [0.2, -1.5], [Some(4.0), Some(4.0)]);
+        assert_eq!((y.driver, y.accommodation_d), (0, 0.0));
+        assert_eq!(y.focus_d, [0.2, -1.5]);
+        assert!((y.residual_d[1] - 1.6).abs() < 1e-12);
+        // A left eye 0.3 D out even relaxed is not sharp: the hyperope drives with 1.6 D, and
+        // the left eye receives the same 1.6 D.
+        let y = yoke([0.0; 2], [0.3, -1.6], [Some(4.0), Some(4.0)]);
+        assert_eq!(y.driver, 1);
+        assert!((y.accommodation_d - 1.6).abs() < 1e-12);
+        assert!(y.focus_d[1].abs() < 1e-12 && (y.focus_d[0] - 1.9).abs() < 1e-12);
+        // With 1 D of amplitude neither sees sharp: the left eye, 0.3 D out, drives over the
+        // hyperope left 0.6 D short.
+        let y = yoke([0.0; 2], [0.3, -1.6], [Some(4.0), Some(1.0)]);
+        assert_eq!((y.driver, y.accommodation_d), (0, 0.0));
     }
 
     #[test]

@@ -153,6 +153,67 @@ pub fn effective_focus(
     })
 }
 
+/// The far point of `eye` as it is (no accommodation), signed (D of object vergence): positive
+/// for a myopic eye (a real point before it), 0 for an emmetropic one, negative for a
+/// hyperopic one or one over-corrected with a minus lens, whose relaxed focus lies beyond
+/// infinity. Beyond infinity the tracer has no object to trace (light arriving converged), so
+/// c(2,0), close to linear in the object vergence, is extrapolated from 0, 1 and 2 D by the
+/// parabola through them.
+pub fn signed_far_point_d(eye: &Eye, pupil_mm: f64, settings: &KernelSettings) -> Result<f64> {
+    let fail = |e: &dyn std::fmt::Display| {
+        Error::input(format!(
+            "the far point: the eye cannot be measured with a {pupil_mm} mm pupil (--pupil-mm): {e}"
+        ))
+    };
+    let sys = eye.system().map_err(|e| fail(&e))?;
+    let meas = Measurer::new(4, 6, 16);
+    let j20 = osa_index(2, 0);
+    let mut buf = [0.0; 15];
+    let mut c20 = |v: f64| -> Result<f64> {
+        meas.coefficients_um(
+            &sys,
+            settings.accommodation_nm,
+            pupil_mm,
+            distance_of(v),
+            &mut buf,
+        )
+        .map_err(|e| fail(&e))?;
+        Ok(buf[j20])
+    };
+    let g = [c20(0.0)?, c20(1.0)?, c20(2.0)?];
+    if g[0] >= 0.0 {
+        return far_point_d(eye, pupil_mm, settings.accommodation_nm, 0.0).map_err(|e| fail(&e));
+    }
+    // g(v) = g0 + b·v + c·v² through the three samples; its root nearest 0 on the negative side.
+    let c = 0.5 * (g[2] - 2.0 * g[1] + g[0]);
+    let b = g[1] - g[0] - c;
+    let linear = -g[0] / b;
+    let v = if c.abs() * linear * linear < 1e-9 * g[0].abs() {
+        linear
+    } else {
+        let disc = b * b - 4.0 * c * g[0];
+        if disc < 0.0 {
+            linear
+        } else {
+            // The root of smaller magnitude, written to avoid cancellation.
+            let q = -0.5 * (b + b.signum() * disc.sqrt());
+            let (r1, r2) = (q / c, g[0] / q);
+            if r1.abs() < r2.abs() {
+                r1
+            } else {
+                r2
+            }
+        }
+    };
+    if !(v.is_finite() && v <= 0.0 && v > -MAX_OBJECT_VERGENCE_D) {
+        return Err(fail(&format!(
+            "the relaxed eye's focus beyond infinity was not found (c(2,0) = {:.2e} µm at 0 D)",
+            g[0]
+        )));
+    }
+    Ok(v)
+}
+
 /// The vergence (D) at which `eye` (as it is, no further accommodation) has no Zernike
 /// defocus, found by the secant method from `start_d` (c(2,0) is close to linear in the object
 /// vergence); 0 where that point lies beyond infinity.

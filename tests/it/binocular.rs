@@ -759,3 +759,122 @@ fn a_stereo_exr_renders_as_its_two_halves() {
     assert!(!dir.join("sizes-left.exr").exists() && !dir.join("one-left.exr").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// An eye made hyperopic by a minus contact lens: its far point lies beyond infinity, by the
+/// lens's power (a thin lens on the cornea, where vergences are counted, adds its power to
+/// every vergence: the oracle, written here). Fixating far beside a partner that sees sharp
+/// for free, it is left relaxed and blurred, as the more hyperopic eye of a pair is; the old
+/// far point clamped at 0 D rendered it accommodated and sharp (the negative control).
+#[test]
+fn an_over_minused_eye_keeps_its_far_point_beyond_infinity_and_stays_blurred() {
+    use ocular::render::binocular::{render_pair, PairRequest};
+    use ocular::render::frame_plan::{Correction, FocusAsked};
+    use ocular::render::live::{LiveOptions, LiveRenderer, SceneArg};
+
+    let eye = ocular::eye::Eye::preset("healthy").unwrap();
+    let contact = |p: f64| Correction {
+        spectacle: Some(ocular::eye::Spectacle::new(p, 0.0, 180.0, 0.0).unwrap()),
+        contact: true,
+        ..Correction::default()
+    };
+    let live = LiveRenderer::new(gpu(), Some(module_cache()), 4);
+    let mut raster = Rasterizer::new(live.context()).unwrap();
+    let focus_m = 6.0;
+    let scene = letter_scene(focus_m);
+    let options = LiveOptions {
+        focus: Some(FocusAsked::DistanceM(focus_m)),
+        pupil_mm: Some(5.0),
+        age: 30.0,
+        ..LiveOptions::default()
+    };
+    let pair = render_pair(
+        &live,
+        &PairRequest {
+            scene: &scene,
+            eyes: [&eye, &eye],
+            options: options.clone(),
+            corrections: [contact(0.0), contact(-1.75)],
+            size: (192, 108),
+            time_s: 0.0,
+            ipd_m: 0.063,
+        },
+    )
+    .unwrap();
+    // The left eye's far point is found where it lies (before the eye), the right one's
+    // extrapolated beyond infinity: they differ by the lens.
+    let [left_fp, right_fp] = pair.far_point_d;
+    assert!(left_fp >= 0.0, "{left_fp}");
+    assert!(
+        (right_fp - (left_fp - 1.75)).abs() < 0.01,
+        "far points {left_fp:.4} D and {right_fp:.4} D: expected {:.4} D",
+        left_fp - 1.75
+    );
+    // The left eye misses 6 m by under 0.125 D relaxed: it drives, with no accommodation, and
+    // the right eye stays relaxed, 1.75 D + the demand short of the letter.
+    let demand = pair.demand_d[1];
+    assert_eq!(pair.yoke.driver, 0, "{:?}", pair.yoke);
+    assert!(pair.yoke.accommodation_d.abs() < 1e-9, "{:?}", pair.yoke);
+    assert!((pair.yoke.focus_d[1] - right_fp).abs() < 1e-9);
+    assert!((pair.yoke.residual_d[1] - (demand - right_fp)).abs() < 1e-9);
+    let scale = 2f32.powf(pair.exposure_ev);
+    let camera = pair.geometry.unwrap().cameras[1];
+    let right_eye = |o: LiveOptions| {
+        live.render_scene_from(
+            SceneArg::Loaded(&scene),
+            &eye,
+            &o,
+            Some((192, 108)),
+            0.0,
+            Some(camera),
+        )
+        .unwrap()
+        .0
+        .color
+    };
+    let shown = LiveOptions {
+        exposure_ev: Some(f64::from(pair.exposure_ev)),
+        ..options.clone()
+    };
+    // The relaxed right eye: no accommodation at all, the letter asked.
+    let relaxed = right_eye(LiveOptions {
+        correction: Correction {
+            accommodation_max_d: Some(0.0),
+            ..contact(-1.75)
+        },
+        ..shown.clone()
+    });
+    // What the clamped far point rendered: the eye accommodating onto the letter.
+    let accommodated = right_eye(LiveOptions {
+        correction: contact(-1.75),
+        ..shown.clone()
+    });
+    let letter = (72, 120);
+    let same = region_psnr(&pair.frames[1].color, &relaxed, (0, 192), scale);
+    let old = region_psnr(&pair.frames[1].color, &accommodated, letter, scale);
+    let mut state = scene.at_time(0.0);
+    state.camera = camera;
+    let sharp = raster.render(live.context(), &state, 192, 108).unwrap();
+    let [right_q, accommodated_q] =
+        [&pair.frames[1].color, &accommodated].map(|c| region_psnr(c, &sharp.color, letter, scale));
+    eprintln!(
+        "far points {left_fp:.4} / {right_fp:.4} D; right frame vs relaxed {same:.1} dB, vs \
+         accommodated {old:.1} dB; letter vs sharp: right {right_q:.1} dB, accommodated \
+         {accommodated_q:.1} dB"
+    );
+    assert!(
+        same > 60.0,
+        "the right frame is not the relaxed eye's: {same:.1} dB"
+    );
+    assert!(
+        old < 30.0,
+        "the relaxed and accommodated eyes look alike: {old:.1} dB"
+    );
+    assert!(
+        accommodated_q > right_q + 6.0,
+        "{accommodated_q:.1} vs {right_q:.1} dB"
+    );
+    // The summary counts the far point beyond infinity in the right frame's report too.
+    assert!((pair.frames[1].report.far_point_d - right_fp).abs() < 1e-12);
+    drop(raster);
+    finish(live.into_context());
+}

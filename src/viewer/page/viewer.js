@@ -191,7 +191,9 @@ function clearErrors() {
   document.querySelectorAll("[aria-invalid]").forEach((e) => e.removeAttribute("aria-invalid"));
 }
 
-const fmtD = (d) => (d > 0 ? `${(1 / d).toFixed(3)} m (${d.toFixed(2)} D)` : "infinity (0 D)");
+// A negative vergence (a hyperopic eye's far point, or its focus in a pair when it exerts too
+// little for infinity) lies beyond infinity.
+const fmtD = (d) => (d > 0 ? `${(1 / d).toFixed(3)} m (${d.toFixed(2)} D)` : d < -1e-9 ? `beyond infinity (${d.toFixed(2)} D)` : "infinity (0 D)");
 
 function summaryHtml(s, header) {
   const esc = (t) => String(t).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
