@@ -59,6 +59,17 @@ pub struct BenchArgs {
     /// early exit) and print the ratio.
     #[arg(long)]
     pub baseline: bool,
+    /// Also time the scene through two eyes, one submission each, in the same run, and print
+    /// the pair's cost against one eye's (docs/binocular.md). Both eyes keep the one-eye run's
+    /// focus and pupil.
+    #[arg(long)]
+    pub binocular: bool,
+    /// With --binocular: the right eye (a preset or an eye file); --eye is then the left.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub eye_right: Option<String>,
+    /// With --binocular: the interpupillary distance in mm (40 to 80; default 63).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub ipd_mm: Option<f64>,
     #[command(flatten)]
     pub cache: super::CacheArgs,
     /// Write the results as JSON.
@@ -150,6 +161,8 @@ struct Report {
     counters: Counters,
     baseline: Option<Baseline>,
     methods: Vec<MethodTime>,
+    /// `--binocular`: both eyes' cost, beside this one eye's.
+    binocular: Option<super::bench_pair::PairBench>,
 }
 
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -191,21 +204,21 @@ struct TimedFrames {
 }
 
 /// The scene frame every timed frame draws again.
-struct SceneInput<'a, 's> {
-    ctx: &'a Context,
-    raster: &'a mut Rasterizer,
-    state: &'a FrameState<'s>,
-    size: (u32, u32),
+pub(super) struct SceneInput<'a, 's> {
+    pub ctx: &'a Context,
+    pub raster: &'a mut Rasterizer,
+    pub state: &'a FrameState<'s>,
+    pub size: (u32, u32),
     /// Depth layers and the peeling gap (dioptres).
-    layers: u32,
-    gap_d: f32,
+    pub layers: u32,
+    pub gap_d: f32,
 }
 
 impl SceneInput<'_, '_> {
     /// One frame from the draw to the image: drawn in splat's own submission (`resident`, the
     /// engine), or drawn, read back to the host and uploaded again (the previous engine), with
     /// the raster's submission, bytes and passes added to what splat counted.
-    fn render(
+    pub fn render(
         &mut self,
         renderer: &mut FrameRenderer,
         eye: crate::render::frame::EyeState,
@@ -352,21 +365,97 @@ impl Precompute {
     }
 }
 
-pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
+/// What the report says of the kernels.
+struct KernelFacts {
+    precompute: Precompute,
+    max_radius_px: u32,
+    field: Option<crate::psf::field::FieldAxes>,
+}
+
+impl Report {
+    /// The one-eye run's report; the optional runs' parts empty.
+    fn timed(
+        args: &BenchArgs,
+        info: &crate::gpu::DeviceInfo,
+        splat: crate::render::splat::SplatSettings,
+        eye_state: EyeState,
+        layers: u32,
+        facts: KernelFacts,
+        timed: &TimedFrames,
+    ) -> Report {
+        Report {
+            device: info.name.clone(),
+            driver: info.driver.clone(),
+            scene: args.scene.clone(),
+            eye: args.eye.clone(),
+            width: args.size.0,
+            height: args.size.1,
+            layers,
+            quality: args.splat.quality.name(),
+            settings: splat,
+            warmup: args.warmup,
+            frames: args.frames,
+            focus_d: eye_state.focus_d,
+            pupil_mm: eye_state.pupil_mm,
+            precompute: facts.precompute,
+            passes: timed.per_pass.iter().map(|(n, v)| stat(n, v)).collect(),
+            total: stat("total", &timed.totals),
+            wall_ms_per_frame: stat("wall", &timed.walls),
+            list_entries: timed.list_entries,
+            live_fragments: timed.live_fragments,
+            kernel_evaluations: timed.kernel_evaluations,
+            evaluations_per_pixel: per_pixel(timed.kernel_evaluations, args.size),
+            texture_reads: timed.texture_reads,
+            texture_reads_per_pixel: per_pixel(timed.texture_reads, args.size),
+            max_radius_px: facts.max_radius_px,
+            psf_texture_bytes: timed.psf_texture_bytes,
+            layer_kernels: timed.layer_kernels,
+            field: facts.field,
+            counters: timed.counters,
+            baseline: None,
+            methods: Vec::new(),
+            binocular: None,
+        }
+    }
+}
+
+/// Checks the options that need no device, and the report's path, before minutes of
+/// benchmarking, not after.
+fn checked_outputs(args: &BenchArgs) -> Result<super::outputs::Outputs> {
     if args.frames == 0 {
         return Err(Error::input("--frames must be at least 1"));
     }
-    // The report's path is checked before minutes of benchmarking, not after.
     let mut outputs = super::outputs::Outputs::new();
     if let Some(path) = &args.json {
         outputs.add("--json", path, &["json"])?;
     }
     outputs.probe()?;
+    if args.binocular {
+        super::bench_pair::ipd_mm(args)?;
+    } else if let Some(option) = [
+        ("--eye-right", args.eye_right.is_some()),
+        ("--ipd-mm", args.ipd_mm.is_some()),
+    ]
+    .iter()
+    .find_map(|(name, given)| given.then_some(name))
+    {
+        return Err(Error::input(format!("{option} needs --binocular")));
+    }
+    Ok(outputs)
+}
+
+/// Per pixel of a frame of `size`.
+fn per_pixel(count: u64, (width, height): (u32, u32)) -> f64 {
+    count as f64 / (f64::from(width) * f64::from(height))
+}
+
+pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
+    let outputs = checked_outputs(args)?;
     let mut splat = args.splat.settings()?;
     let eye = load_eye(&args.eye)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
-    let (width, height) = args.size;
+    let width = args.size.0;
     let (frame, eye_state, screen) =
         super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm, false)?;
     // the white `render` would show this frame at, as the unit of the merge's colour bound
@@ -376,19 +465,21 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let mut options = args.cache.kernel_options();
     options.field_width_px = args.splat.off_axis.then_some(width);
     let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
-    let precompute = Precompute::of(&kernels);
-    let max_radius_px = kernels.grid.max_radius_px;
-    let field = kernels.field.as_ref().map(|f| f.plan.axes.clone());
+    let facts = KernelFacts {
+        precompute: Precompute::of(&kernels),
+        max_radius_px: kernels.grid.max_radius_px,
+        field: kernels.field.as_ref().map(|f| f.plan.axes.clone()),
+    };
     let baseline_inputs = args.baseline.then(|| (eye.clone(), kernels.clone()));
+    let right_inputs =
+        super::bench_pair::right_eye(args, &eye, &kernels, &frame, (eye_state, screen), &options)?;
     let mut notes = Vec::new();
     let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
-    for n in &notes {
-        println!("note: {n}");
-    }
+    notes.iter().for_each(|n| println!("note: {n}"));
     let gap_d = splat.blend.group_tolerance_d;
     let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
     let input = frame.input(screen.fov_y_deg);
-    let runs = if args.baseline { 2 } else { 1 };
+    let runs = 1 + usize::from(args.baseline) + usize::from(args.binocular);
     let bar = super::frame_progress_bar((runs * (args.warmup + args.frames)) as u64);
     let scene_state = scene.at_time(0.0);
     let mut raster = Rasterizer::new(&ctx)?;
@@ -402,17 +493,44 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     };
     let timed = time_frames(&mut renderer, &mut scene_input, true, eye_state, args, &bar)?;
     let baseline = match baseline_inputs {
-        Some((eye, kernels)) => {
-            let old =
-                FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), paper(splat));
-            let mut run = BaselineRun {
-                renderer: old,
+        Some((eye, kernels)) => Some(
+            BaselineRun {
+                renderer: FrameRenderer::new(
+                    &ctx,
+                    eye,
+                    kernels,
+                    options.settings.clone(),
+                    paper(splat),
+                ),
                 scene: &mut scene_input,
                 eye_state,
                 bar: &bar,
-            };
-            Some(run.time(args, &timed)?)
-        }
+            }
+            .time(args, &timed)?,
+        ),
+        None => None,
+    };
+    let binocular = match right_inputs {
+        Some((eye, kernels)) => Some(
+            super::bench_pair::PairRun {
+                ctx: &ctx,
+                raster: scene_input.raster,
+                state: &scene_state,
+                eye_state,
+                layers,
+                gap_d,
+                one_eye_ms: (
+                    stat("", &timed.totals).mean_ms,
+                    stat("", &timed.walls).mean_ms,
+                ),
+            }
+            .time(
+                args,
+                &mut renderer,
+                (eye, kernels, options.settings.clone(), splat),
+                &bar,
+            )?,
+        ),
         None => None,
     };
     bar.finish_and_clear();
@@ -426,44 +544,27 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     } else {
         Vec::new()
     };
-    let info = ctx.device_info();
-    let report = Report {
-        device: info.name.clone(),
-        driver: info.driver.clone(),
-        scene: args.scene.clone(),
-        eye: args.eye.clone(),
-        width,
-        height,
+    let mut report = Report::timed(
+        args,
+        ctx.device_info(),
+        splat,
+        eye_state,
         layers,
-        quality: args.splat.quality.name(),
-        settings: splat,
-        warmup: args.warmup,
-        frames: args.frames,
-        focus_d: eye_state.focus_d,
-        pupil_mm: eye_state.pupil_mm,
-        precompute,
-        passes: timed.per_pass.iter().map(|(n, v)| stat(n, v)).collect(),
-        total: stat("total", &timed.totals),
-        wall_ms_per_frame: stat("wall", &timed.walls),
-        list_entries: timed.list_entries,
-        live_fragments: timed.live_fragments,
-        kernel_evaluations: timed.kernel_evaluations,
-        evaluations_per_pixel: timed.kernel_evaluations as f64
-            / (f64::from(width) * f64::from(height)),
-        texture_reads: timed.texture_reads,
-        texture_reads_per_pixel: timed.texture_reads as f64
-            / (f64::from(width) * f64::from(height)),
-        max_radius_px,
-        psf_texture_bytes: timed.psf_texture_bytes,
-        layer_kernels: timed.layer_kernels,
-        field,
-        counters: timed.counters,
-        baseline,
-        methods,
-    };
-    print_table(&report);
+        facts,
+        &timed,
+    );
+    (report.baseline, report.methods, report.binocular) = (baseline, methods, binocular);
+    write_report(&report, args, outputs)
+}
+
+/// Prints the report and writes its JSON where asked.
+fn write_report(report: &Report, args: &BenchArgs, outputs: super::outputs::Outputs) -> Result<()> {
+    print_table(report);
+    if let Some(p) = &report.binocular {
+        super::bench_pair::print(p);
+    }
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&report)
+        let text = serde_json::to_string_pretty(report)
             .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
         crate::image_io::write_text_atomic(outputs.temporary(path), &text)?;
     }

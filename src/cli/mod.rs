@@ -6,6 +6,7 @@ use crate::gpu::ContextOptions;
 use crate::Result;
 
 mod bench;
+mod bench_pair;
 mod binocular;
 mod compare;
 mod compare_files;

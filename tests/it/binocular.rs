@@ -230,8 +230,11 @@ fn a_monovision_pair_shares_one_accommodation() {
 
 #[test]
 fn binocular_options_are_checked() {
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 9] = [
         (&["render", "--ipd-mm", "63"], "--binocular"),
+        (&["bench", "--ipd-mm", "63"], "--binocular"),
+        (&["bench", "--eye-right", "healthy"], "--binocular"),
+        (&["bench", "--binocular", "--ipd-mm", "90"], "--ipd-mm"),
         (&["render", "--binocular", "--ipd-mm", "20"], "--ipd-mm"),
         (
             &[
@@ -877,4 +880,55 @@ fn an_over_minused_eye_keeps_its_far_point_beyond_infinity_and_stays_blurred() {
     assert!((pair.frames[1].report.far_point_d - right_fp).abs() < 1e-12);
     drop(raster);
     finish(live.into_context());
+}
+
+/// `ocular bench --binocular` times both eyes in the same run as one: each pair is two
+/// submissions, and its work is both eyes' (each eye's frame, from 31.5 mm to the side, costs
+/// about what the camera's does: a pair that rendered one eye twice over, or one eye only,
+/// would miss the bounds). Its times are reported, not asserted (docs/binocular.md, "Cost").
+#[test]
+fn bench_times_a_pair_beside_one_eye() {
+    let dir = temp_dir("binocular-bench");
+    let path = dir.join("bench.json");
+    let out = ocular_run(&[
+        "bench",
+        "--scene",
+        "primitives",
+        "--eye",
+        "myopia",
+        "--size",
+        "160x90",
+        "--warmup",
+        "1",
+        "--frames",
+        "1",
+        "--binocular",
+        "--eye-right",
+        "healthy",
+        "--json",
+        path.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("two eyes"));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let pair = &r["binocular"];
+    assert_eq!(pair["submissions"], 2, "{pair}");
+    assert_eq!(pair["eye_right"], "healthy");
+    assert_eq!(pair["ipd_mm"], 63.0);
+    let one = r["kernel_evaluations"].as_f64().unwrap();
+    let both = pair["kernel_evaluations"].as_f64().unwrap();
+    // the healthy right eye blurs less than the myopic left: more than one eye's work, less
+    // than two myopic eyes'
+    assert!(
+        both > 1.05 * one && both < 2.0 * one,
+        "one eye {one}, pair {both}"
+    );
+    for k in ["gpu_ratio", "wall_ratio"] {
+        assert!(pair[k].as_f64().unwrap() > 1.0, "{k}: {pair}");
+    }
 }
