@@ -15,7 +15,7 @@ use crate::image_io::{self, ImageRgba, Tonemap};
 use crate::render::binocular::{self, FilePairRequest, PairRequest, Yoke, SIDES};
 use crate::render::frame::HostFrame;
 use crate::render::frame::Method;
-use crate::render::frame_plan::Correction;
+use crate::render::frame_plan::{Correction, IolPower};
 use crate::render::live::{LiveOptions, LiveRenderer};
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -32,6 +32,23 @@ pub enum StereoOutput {
     Anaglyph,
 }
 
+/// `--iol-d-right`: the right eye's own IOL, or none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RightIol {
+    /// The right eye keeps its crystalline lens.
+    None,
+    Power(IolPower),
+}
+
+pub fn parse_right_iol(text: &str) -> std::result::Result<RightIol, String> {
+    if text.trim().eq_ignore_ascii_case("none") {
+        return Ok(RightIol::None);
+    }
+    IolPower::parse(text)
+        .map(RightIol::Power)
+        .map_err(|e| format!("{e} (or none)"))
+}
+
 /// Whether the options ask for two eyes.
 pub fn asked(args: &RenderArgs) -> bool {
     args.binocular || args.eye_right.is_some()
@@ -44,6 +61,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
             ("--ipd-mm", args.ipd_mm.is_some()),
             ("--stereo", args.stereo.is_some()),
             ("--correct-right", args.correct_right.is_some()),
+            ("--iol-d-right", args.iol_d_right.is_some()),
             ("--color-right", args.color_right.is_some()),
         ];
         if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
@@ -162,6 +180,11 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         base.correction.clone(),
         Correction {
             spectacle: args.correct_right.or(base.correction.spectacle),
+            iol: match args.iol_d_right {
+                Some(RightIol::None) => None,
+                Some(RightIol::Power(p)) => Some(p),
+                None => base.correction.iol,
+            },
             ..base.correction.clone()
         },
     ];

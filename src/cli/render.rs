@@ -95,6 +95,12 @@ pub struct RenderArgs {
     /// --vertex-mm and --correct-contact it shares); --correct is then the left eye's.
     #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
     pub correct_right: Option<crate::eye::correction::Spectacle>,
+    /// The right eye's own intraocular lens: a power in dioptres (-10 to 40), `auto` (the
+    /// emmetropic one) or `none` (the right eye keeps its crystalline lens); --iol-d is then
+    /// the left eye's. A pseudophakic monovision pair: --iol-d auto --iol-d-right with a
+    /// stronger lens.
+    #[arg(long, value_name = "D|auto|none", value_parser = super::binocular::parse_right_iol, allow_hyphen_values = true)]
+    pub iol_d_right: Option<super::binocular::RightIol>,
     /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
     #[arg(long, value_name = "MM", allow_negative_numbers = true)]
     pub ipd_mm: Option<f64>,

@@ -248,7 +248,12 @@ fn eye_limits(
     // Signed: a hyperopic eye's far point lies beyond infinity, and reaching even infinity
     // spends some of its amplitude.
     let far = signed_far_point_d(&corrected, pupil_mm, &settings)?;
-    Ok((far, physiology.accommodation_max_d, physiology.correction))
+    let iol = physiology.iol_d.map(|p| format!("IOL {p:.2} D"));
+    let correction = match (physiology.correction, iol) {
+        (Some(c), Some(i)) => Some(format!("{c}, {i}")),
+        (c, i) => c.or(i),
+    };
+    Ok((far, physiology.accommodation_max_d, correction))
 }
 
 /// What both kinds of pair share once the demands, the pupil and the exposure are known: each

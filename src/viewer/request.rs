@@ -437,16 +437,15 @@ impl ViewRequest {
                 let right_eye = eye_word(&right.eye, "eye-rx-right.toml");
                 pair.extend(["--eye-right".into(), right_eye]);
             }
-            let correction = if left.correction_cli.is_empty() {
-                &right.correction_cli
-            } else {
-                &left.correction_cli
-            };
-            pair.extend(correction.iter().cloned());
+            pair.extend(left.correction_cli.iter().cloned());
             if let (Some(l), Some(r)) = (spectacle_rx(left), spectacle_rx(right)) {
                 if l != r {
                     pair.extend(["--correct-right".into(), r.to_string()]);
                 }
+            }
+            if left.correction.iol != right.correction.iol {
+                let power = iol_word(right).unwrap_or("none");
+                pair.extend(["--iol-d-right".into(), power.to_string()]);
             }
             if ipd_mm != crate::render::binocular::DEFAULT_IPD_MM {
                 pair.extend(["--ipd-mm".into(), format!("{ipd_mm}")]);
@@ -517,21 +516,24 @@ fn spectacle_rx(side: &Side) -> Option<&str> {
         .map(String::as_str)
 }
 
+/// A side's IOL power as typed (`--iol-d`'s value).
+fn iol_word(side: &Side) -> Option<&str> {
+    let words = &side.correction_cli;
+    words
+        .iter()
+        .position(|w| w == "--iol-d")
+        .and_then(|i| words.get(i + 1))
+        .map(String::as_str)
+}
+
 /// What `ocular render --binocular` can express of two eyes' corrections: the right eye may
 /// have its own spectacle or contact lens prescription (`--correct-right`), of the left's
-/// kind and vertex distance; an IOL is the same in both.
+/// kind and vertex distance, and its own IOL or none (`--iol-d-right`).
 fn check_pair(sides: &[Side], off_axis: bool) -> Checked<()> {
     if off_axis {
         return Err("--binocular does not take --off-axis yet".into());
     }
     let (l, r) = (&sides[0].correction, &sides[1].correction);
-    if l.iol != r.iol {
-        return Err(
-            "a binocular pair takes one IOL for both eyes (a per-eye IOL is not built \
-                     yet)"
-                .into(),
-        );
-    }
     let kind = |c: &Correction| (c.spectacle.is_some(), c.contact, c.vertex_mm);
     let (kl, kr) = (kind(l), kind(r));
     if kl.0 && kr.0 && (kl.1, kl.2) != (kr.1, kr.2) {
@@ -640,6 +642,28 @@ mod tests {
             assert!(e.contains(option), "{e} should name {option}");
             assert!(!e.contains('\n'), "{e}");
         }
+    }
+
+    #[test]
+    fn a_pair_with_an_iol_in_one_eye_is_one_command() {
+        let catalog = Catalog::load(None, None).unwrap();
+        let eye = r#"{"kind":"preset","name":"myopia"}"#;
+        let pair = |a: &str, b: &str| {
+            let json = format!(
+                r#"{{"scene":"chart","size":[640,360],"age":30,"quality":"fast","binocular":true,"a":{{"eye":{eye},"correction":{a}}},"b":{{"eye":{eye},"correction":{b}}}}}"#
+            );
+            let r = ViewRequest::check(settings(&json), &catalog, &bounds()).unwrap();
+            r.command_line(0, &catalog, "pair.png")
+        };
+        let none = r#"{"kind":"none"}"#;
+        let line = pair(r#"{"kind":"iol","power":"auto"}"#, none);
+        assert!(
+            line.contains("--binocular --eye myopia --iol-d auto --iol-d-right none"),
+            "{line}"
+        );
+        let line = pair(none, r#"{"kind":"iol","power":"21.5"}"#);
+        assert!(line.contains("--eye myopia --iol-d-right 21.5"), "{line}");
+        assert!(!line.contains("--iol-d "), "{line}");
     }
 
     #[test]

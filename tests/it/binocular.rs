@@ -932,3 +932,90 @@ fn bench_times_a_pair_beside_one_eye() {
         assert!(pair[k].as_f64().unwrap() > 1.0, "{k}: {pair}");
     }
 }
+
+/// A pseudophakic monovision pair: both crystalline lenses replaced, the left by the IOL that
+/// makes the eye emmetropic, the right by one 2.5 D stronger, so that it is myopic by about
+/// 1.8 D. Neither accommodates: each eye stays at its own far point whatever the target, the
+/// far letter sharp in the left eye and the near one in the right. The negative control is the
+/// pair with one IOL for both (what `--iol-d` alone gives), which sees the near letter sharp in
+/// neither eye.
+#[test]
+fn a_pseudophakic_monovision_pair_sees_far_with_one_eye_and_near_with_the_other() {
+    use ocular::render::binocular::{render_pair, PairRequest};
+    use ocular::render::frame_plan::{Correction, FocusAsked, IolPower};
+    use ocular::render::live::{LiveOptions, LiveRenderer};
+
+    let eye = ocular::eye::Eye::preset("healthy").unwrap();
+    let live = LiveRenderer::new(gpu(), Some(module_cache()), 4);
+    let mut raster = Rasterizer::new(live.context()).unwrap();
+    let iol = |power: IolPower| Correction {
+        iol: Some(power),
+        ..Correction::default()
+    };
+    let auto_d = ocular::render::frame_plan::corrected_eye(&eye, &iol(IolPower::Auto), None)
+        .unwrap()
+        .1
+        .iol_d
+        .unwrap();
+    let monovision = [iol(IolPower::Auto), iol(IolPower::Dioptres(auto_d + 2.5))];
+    let same = [iol(IolPower::Auto), iol(IolPower::Auto)];
+    let letter = (72, 120);
+    // Per target distance, per pair: the letter's PSNR against the sharp frame in each eye.
+    let mut seen = Vec::new();
+    for focus_m in [6.0, 0.5] {
+        let scene = letter_scene(focus_m);
+        for corrections in [monovision.clone(), same.clone()] {
+            let pair = render_pair(
+                &live,
+                &PairRequest {
+                    scene: &scene,
+                    eyes: [&eye, &eye],
+                    options: LiveOptions {
+                        focus: Some(FocusAsked::DistanceM(focus_m)),
+                        pupil_mm: Some(4.0),
+                        age: 70.0,
+                        ..LiveOptions::default()
+                    },
+                    corrections,
+                    size: (192, 108),
+                    time_s: 0.0,
+                    ipd_m: 0.063,
+                },
+            )
+            .unwrap();
+            assert_eq!(pair.amplitude_d, [Some(0.0), Some(0.0)]);
+            assert_eq!(pair.yoke.accommodation_d, 0.0);
+            assert_eq!(pair.yoke.focus_d, pair.far_point_d);
+            let scale = 2f32.powf(pair.exposure_ev);
+            let q = [0, 1].map(|e| {
+                let mut state = scene.at_time(0.0);
+                state.camera = pair.geometry.unwrap().cameras[e];
+                let sharp = raster.render(live.context(), &state, 192, 108).unwrap();
+                region_psnr(&pair.frames[e].color, &sharp.color, letter, scale)
+            });
+            seen.push((focus_m, pair.far_point_d, q));
+        }
+    }
+    eprintln!("(target m, far points D, letter dB per eye): {seen:?}");
+    let [(_, far_points, far_mono), (_, _, far_same), (_, _, near_mono), (_, _, near_same)] =
+        seen[..]
+    else {
+        unreachable!()
+    };
+    // The stronger IOL makes the right eye myopic by about 0.7 of its extra power: a thin
+    // lens a reduced distance t behind a cornea of power K adds (1 − t·K)² of its power at
+    // the cornea, 0.70 for t = 5 mm / 1.336 and K = 43 D (1.76 D; the traced eye: 1.86 D).
+    assert!(far_points[0].abs() < 0.25, "{far_points:?}");
+    let myopia = far_points[1] - far_points[0];
+    assert!((1.5..2.2).contains(&myopia), "{far_points:?}");
+    assert!(far_mono[0] > far_mono[1] + 6.0, "far: {far_mono:?}");
+    assert!(near_mono[1] > near_mono[0] + 6.0, "near: {near_mono:?}");
+    // One IOL for both: near, neither eye sees the letter as the monovision right eye does.
+    assert!(
+        near_same[0].max(near_same[1]) < near_mono[1] - 6.0,
+        "near, one IOL: {near_same:?} against {near_mono:?}"
+    );
+    assert!((far_same[0] - far_same[1]).abs() < 1.0, "{far_same:?}");
+    drop(raster);
+    finish(live.into_context());
+}
