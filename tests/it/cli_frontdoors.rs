@@ -287,8 +287,10 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
     // the scene in splat's own submission: no frame is uploaded.
     assert!(!names.contains(&"psf texture"), "{names:?}");
     assert!(!names.contains(&"upload"), "{names:?}");
+    // per frame only the object radii (32 bytes per distance), the field table and the
+    // uniforms: a few KiB, where the frame's pixels would be 160 × 90 × 20 bytes
     assert!(
-        report["counters"]["upload_bytes"].as_u64().unwrap() < 4096,
+        report["counters"]["upload_bytes"].as_u64().unwrap() < 8192,
         "{}",
         report["counters"]
     );
@@ -370,7 +372,7 @@ fn peeled_layers_stay_on_the_gpu_in_bench_and_render() {
     let layer_bytes = 2 * 160 * 90 * 20;
     assert_eq!(c["submissions"], 1, "{c}");
     assert_eq!(c["allocations"], 0, "{c}");
-    assert!(c["upload_bytes"].as_u64().unwrap() < 4096, "{c}");
+    assert!(c["upload_bytes"].as_u64().unwrap() < 8192, "{c}");
     // the image and the band table's header
     assert_eq!(c["readback_bytes"], 160 * 90 * 16 + 32, "{c}");
     assert!(old["upload_bytes"].as_u64().unwrap() > layer_bytes, "{old}");

@@ -127,12 +127,13 @@ fn steady_frames_are_one_submission_without_allocations() {
             image_bytes + 32,
             "image and band header"
         );
-        // the pixels, the radii, the field table (its header and one node's radii) and the
-        // frame's uniforms
+        // the pixels, the radii (per object distance two vec4: natural and core radii, and
+        // the peak radius), the field table (its header and one node's radii) and the frame's
+        // uniforms
         assert!(
             next.stats.upload_bytes
                 <= u64::from(W * H) * 20
-                    + 2 * 11 * 16
+                    + 3 * 11 * 16
                     + 32
                     + ocular::render::splat::FRAME_UNIFORM_BYTES
         );
