@@ -32,3 +32,5 @@ pub use frame::{
     dioptre_range, prepare_kernels, scene_needs, EyeState, FrameRenderer, KernelOptions, Method,
     PreparedKernels,
 };
+// An eye's far point, signed (beyond infinity for a hyperopic eye).
+pub use focus::signed_far_point_d;
