@@ -194,7 +194,8 @@ pub struct SplatArgs {
     /// The most that averaging one merged block's colours may change any pixel, block by block,
     /// as a fraction of the white the image is shown at (--exposure, else the frame's automatic
     /// exposure; preset: balanced 1/16320, a quarter of an 8-bit step shared by the 16 or so
-    /// blocks a kernel's rim crosses, since their errors add; fast 1/255). A block of side s
+    /// blocks a kernel's rim crosses, since their errors add; fast 1/1602, a whole step shared by
+    /// the 2π blocks a rim crosses when blocks are as wide as the blur). A block of side s
     /// under blur radius r merges when its parts' colours differ by at most 4π·E·(r/s)²: the
     /// wider the blur against the block, the larger the difference that cannot show.
     #[arg(long, value_name = "E", allow_hyphen_values = true)]

@@ -77,25 +77,24 @@ fn each_preset_meets_its_floor_and_the_next_cheaper_setting_misses_it() {
         );
         // exact merges nothing: at least balanced's work and quality
         assert!(exact.evaluations >= balanced.evaluations && exact.db >= balanced.db - 0.01);
-        // balanced keeps exact's image within 0.5 dB (measured: 0.13 and 0.00 dB); fast, the
-        // next cheaper, misses that by 25 dB and more on these textures
+        // balanced keeps exact's image within 0.5 dB (measured: 0.01 and 0.00 dB)
         assert!(
             balanced.db >= exact.db - 0.5,
             "{eye}: balanced {:.2} dB",
             balanced.db
         );
-        assert!(fast.db < exact.db - 0.5, "{eye}: fast {:.2} dB", fast.db);
-        // fast stays within the seed paper's own distance from its truth, 46–51 dB (measured:
-        // 46.16 and 71.28 dB), never with more work than balanced, and with at most half of it
-        // where the kernels have no sharp peak (myopia: 7.4× fewer evaluations). The colour
-        // rule bounds the error by the kernel's peak height, and the keratoconic eye's kernels
-        // peak sharply: averaging these textures under them would show, so fast merges little
-        // of them (3.82 M evaluations against 3.85 M; bounded by the core radius instead, it
-        // did 2.3× fewer at 48.03 dB). Without its colour rule fast falls to 40.40 and
-        // 36.34 dB.
+        // fast stays within the seed paper's own distance from its truth, 46–51 dB, never with
+        // more work than balanced. Where the kernels have no sharp peak (myopia) it is the
+        // trade: 50.96 dB for 3.05× fewer evaluations, so it misses balanced's floor. The
+        // colour rule bounds the error by the kernel's peak height, and the keratoconic eye's
+        // kernels peak sharply: averaging these textures under them would show, so fast
+        // merges none of them and equals exact (72.67 dB; with the bound per block and the
+        // core's r50 for the peak, it did 2.3× fewer evaluations at 48.03 dB). Without its
+        // colour rule fast falls to 40.40 and 36.34 dB, the negative control below.
         assert!(fast.db >= 45.0, "{eye}: fast {:.2} dB", fast.db);
         assert!(fast.evaluations <= balanced.evaluations, "{eye}");
         if eye == "myopia" {
+            assert!(fast.db < exact.db - 0.5, "{eye}: fast {:.2} dB", fast.db);
             assert!(2 * fast.evaluations <= balanced.evaluations, "{eye}");
         }
         assert!(
@@ -140,7 +139,8 @@ fn the_preset_is_named_in_bench_json_and_a_bad_one_is_refused() {
     assert_eq!(report["quality"], "fast");
     let merge = &report["settings"]["merge"];
     // the preset's colour rule and block width, refined by the option given
-    assert!((merge["color_error"].as_f64().unwrap() - 1.0 / 255.0).abs() < 1e-9);
+    let shared = 1.0 / (255.0 * std::f64::consts::TAU);
+    assert!((merge["color_error"].as_f64().unwrap() - shared).abs() < 1e-9);
     assert_eq!(merge["blur_per_block"].as_f64().unwrap(), 1.0);
     assert_eq!(merge["min_radius_px"].as_f64().unwrap(), 3.0);
     let out = common::ocular_run(&["render", "--quality", "fastest", "-o", "x.png"]);
