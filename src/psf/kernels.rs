@@ -176,19 +176,26 @@ impl KernelSet {
     /// wide flare (coma, keratoconus) it is far smaller, and that core is what averaging a
     /// block of fragments would smear.
     pub fn core_radii_px(&self) -> Vec<[f32; 3]> {
+        self.per_natural_kernel(|values, r| {
+            std::f64::consts::SQRT_2 * encircled_radius(values, r, 0.5)
+        })
+    }
+
+    /// Per object distance and channel, `of` one channel's kernel at its natural radius (its
+    /// texels and the block radius of the level holding it).
+    fn per_natural_kernel(&self, of: impl Fn(&[f64], u32) -> f64) -> Vec<[f32; 3]> {
         let levels = level_count(self.max_radius_px);
         (0..self.objects.count)
             .map(|o| {
                 [0, 1, 2].map(|c| {
                     let natural = f64::from(self.radius_px[o][c]);
                     let level = (level_of_radius(natural).round() as u32).min(levels - 1);
-                    let r = level_block_radius(level);
                     let values: Vec<f64> = self
                         .kernel(level, o)
                         .iter()
                         .map(|t| f64::from(t[c]))
                         .collect();
-                    (std::f64::consts::SQRT_2 * encircled_radius(&values, r, 0.5)) as f32
+                    of(&values, level_block_radius(level)) as f32
                 })
             })
             .collect()
@@ -204,24 +211,14 @@ impl KernelSet {
     /// which counts a line of length L as a disc of diameter about L/√2 and so puts its height
     /// several times too low.
     pub fn peak_radii_px(&self) -> Vec<[f32; 3]> {
-        let levels = level_count(self.max_radius_px);
-        (0..self.objects.count)
-            .map(|o| {
-                [0, 1, 2].map(|c| {
-                    let natural = f64::from(self.radius_px[o][c]);
-                    let level = (level_of_radius(natural).round() as u32).min(levels - 1);
-                    let (mut sum, mut peak) = (0.0f64, 0.0f64);
-                    for t in self.kernel(level, o) {
-                        sum += f64::from(t[c]);
-                        peak = peak.max(f64::from(t[c]));
-                    }
-                    if sum <= 0.0 || peak <= 0.0 || !sum.is_finite() {
-                        return 0.5;
-                    }
-                    (1.0 / (std::f64::consts::PI * peak / sum)).sqrt() as f32
-                })
-            })
-            .collect()
+        self.per_natural_kernel(|values, _| {
+            let sum: f64 = values.iter().sum();
+            let peak = values.iter().copied().fold(0.0, f64::max);
+            if sum <= 0.0 || peak <= 0.0 || !sum.is_finite() {
+                return 0.5;
+            }
+            (1.0 / (std::f64::consts::PI * peak / sum)).sqrt()
+        })
     }
 
     /// Bytes of the texels as stored for the GPU (three f32 per texel).

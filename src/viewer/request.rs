@@ -438,13 +438,16 @@ impl ViewRequest {
                 pair.extend(["--eye-right".into(), right_eye]);
             }
             pair.extend(left.correction_cli.iter().cloned());
-            if let (Some(l), Some(r)) = (spectacle_rx(left), spectacle_rx(right)) {
+            if let (Some(l), Some(r)) = (
+                correction_value(left, "--correct"),
+                correction_value(right, "--correct"),
+            ) {
                 if l != r {
                     pair.extend(["--correct-right".into(), r.to_string()]);
                 }
             }
             if left.correction.iol != right.correction.iol {
-                let power = iol_word(right).unwrap_or("none");
+                let power = correction_value(right, "--iol-d").unwrap_or("none");
                 pair.extend(["--iol-d-right".into(), power.to_string()]);
             }
             if ipd_mm != crate::render::binocular::DEFAULT_IPD_MM {
@@ -506,22 +509,13 @@ impl ViewRequest {
     }
 }
 
-/// A side's spectacle or contact lens prescription as typed (`--correct`'s value).
-fn spectacle_rx(side: &Side) -> Option<&str> {
+/// The value a side's correction words give `option` (`--correct`'s prescription, `--iol-d`'s
+/// power), as typed.
+fn correction_value<'a>(side: &'a Side, option: &str) -> Option<&'a str> {
     let words = &side.correction_cli;
     words
         .iter()
-        .position(|w| w == "--correct")
-        .and_then(|i| words.get(i + 1))
-        .map(String::as_str)
-}
-
-/// A side's IOL power as typed (`--iol-d`'s value).
-fn iol_word(side: &Side) -> Option<&str> {
-    let words = &side.correction_cli;
-    words
-        .iter()
-        .position(|w| w == "--iol-d")
+        .position(|w| w == option)
         .and_then(|i| words.get(i + 1))
         .map(String::as_str)
 }
