@@ -64,6 +64,11 @@ pub struct BenchArgs {
     /// focus and pupil.
     #[arg(long)]
     pub binocular: bool,
+    /// A diagnostic of the draw: shade nothing (each surface its reflectance, unlit), so the
+    /// raster pass times the fixed-function work alone (rasterising, writing 4 samples a pixel,
+    /// resolving). The frame is not the scene's, and the splat's passes see other colours.
+    #[arg(long)]
+    pub draw_unshaded: bool,
     /// With --binocular: the right eye (a preset or an eye file); --eye is then the left.
     #[arg(long, value_name = "NAME|FILE")]
     pub eye_right: Option<String>,
@@ -163,6 +168,8 @@ struct Report {
     methods: Vec<MethodTime>,
     /// `--binocular`: both eyes' cost, beside this one eye's.
     binocular: Option<super::bench_pair::PairBench>,
+    /// `--draw-unshaded`: the draw shaded nothing (a diagnostic of its fixed-function cost).
+    draw_unshaded: bool,
 }
 
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -415,6 +422,7 @@ impl Report {
             baseline: None,
             methods: Vec::new(),
             binocular: None,
+            draw_unshaded: false,
         }
     }
 }
@@ -482,7 +490,12 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let runs = 1 + usize::from(args.baseline) + usize::from(args.binocular);
     let bar = super::frame_progress_bar((runs * (args.warmup + args.frames)) as u64);
     let scene_state = scene.at_time(0.0);
-    let mut raster = Rasterizer::new(&ctx)?;
+    let mut raster = if args.draw_unshaded {
+        println!("note: --draw-unshaded: the draw shades nothing; only its time is meaningful");
+        Rasterizer::with_inputs(&ctx, crate::render::SurfaceInputs::Unshaded)?
+    } else {
+        Rasterizer::new(&ctx)?
+    };
     let mut scene_input = SceneInput {
         ctx: &ctx,
         raster: &mut raster,
@@ -554,6 +567,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         &timed,
     );
     (report.baseline, report.methods, report.binocular) = (baseline, methods, binocular);
+    report.draw_unshaded = args.draw_unshaded;
     write_report(&report, args, outputs)
 }
 

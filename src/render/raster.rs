@@ -32,6 +32,10 @@ pub enum SurfaceInputs {
     /// At the pixel's centre, inside the triangle or not: extrapolated past silhouettes. The
     /// behaviour before the fix, kept as a negative control for tests.
     PixelCentre,
+    /// None: every surface shows its material's reflectance, unlit, at the depth interpolated
+    /// inside its samples. A timing diagnostic only (`ocular bench --draw-unshaded`): what the
+    /// draw costs without its fragment work; the frame is not the scene's.
+    Unshaded,
 }
 
 /// Samples per pixel.
@@ -259,6 +263,10 @@ impl Rasterizer {
             (false, SurfaceInputs::PixelCentre) => (
                 "raster (pixel-centre inputs)",
                 crate::shaders::RENDER_RASTER_CENTRE_FRAG,
+            ),
+            (false, SurfaceInputs::Unshaded) => (
+                "raster (unshaded)",
+                crate::shaders::RENDER_RASTER_UNSHADED_FRAG,
             ),
         };
         Ok(

@@ -314,3 +314,53 @@ fn shipped_scenes_have_no_foreign_edge_pixels() {
     drop((covered, centre));
     common::finish(ctx);
 }
+
+/// `bench --draw-unshaded` times the draw without its fragment work, so its frame must be the
+/// same draw minus the shading: the same depths (the same coverage and interpolation), colours
+/// that no light changes, where the shaded frame follows the light.
+#[test]
+fn the_unshaded_draw_keeps_the_depths_and_drops_the_lighting() {
+    let ctx = common::gpu();
+    let mut shaded = Rasterizer::new(&ctx).unwrap();
+    let mut unshaded = Rasterizer::with_inputs(&ctx, SurfaceInputs::Unshaded).unwrap();
+    let size = (320, 180);
+    let (a, b) = (
+        test_scene([0.3, -0.5, -1.0]),
+        test_scene([-0.8, -0.2, -0.4]),
+    );
+    let (shaded_a, shaded_b) = (
+        render(&mut shaded, &ctx, &a, size),
+        render(&mut shaded, &ctx, &b, size),
+    );
+    let (flat_a, flat_b) = (
+        render(&mut unshaded, &ctx, &a, size),
+        render(&mut unshaded, &ctx, &b, size),
+    );
+    // The shaded depth is bounded to what its triangle can have (raster_shade.glsl); the
+    // bound is inactive on every well-conditioned pixel, so almost every depth agrees exactly.
+    let same_depth = shaded_a
+        .depth_m
+        .iter()
+        .zip(&flat_a.depth_m)
+        .filter(|(s, u)| (*s - *u).abs() <= 1e-6 * s.abs())
+        .count();
+    let pixels = shaded_a.depth_m.len();
+    assert!(
+        same_depth * 1000 >= pixels * 998,
+        "{same_depth} of {pixels}"
+    );
+    let differ = |x: &[[f32; 4]], y: &[[f32; 4]]| {
+        x.iter()
+            .zip(y)
+            .filter(|(p, q)| (0..3).any(|c| (p[c] - q[c]).abs() > 1e-3 * p[c].abs().max(1e-3)))
+            .count()
+    };
+    // the light moved: a large share of the shaded surfaces changed, none of the unshaded ones
+    assert!(
+        differ(&shaded_a.color, &shaded_b.color) * 10 > pixels,
+        "shaded frames agree"
+    );
+    assert_eq!(differ(&flat_a.color, &flat_b.color), 0);
+    drop((shaded, unshaded));
+    common::finish(ctx);
+}
