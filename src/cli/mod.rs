@@ -164,8 +164,8 @@ impl BlendArgs {
 pub struct SplatArgs {
     /// Speed against accuracy: `exact` (no merging, no early exit: what the tests judge
     /// against), `balanced` (merges only what cannot show) or `fast` (merges blocks as wide as
-    /// the blur under a 64× looser colour rule: 2.5–2.6× faster at 640×360 on lavapipe, 1.6–2.3 dB;
-    /// docs/quality.md).
+    /// the blur under a colour rule about 10× looser: 1.9–2.4× faster at 640×360 on lavapipe;
+    /// docs/quality.md measures its error scene by scene).
     /// The --merge-* options below refine the preset.
     #[arg(long, value_enum, default_value = "balanced")]
     pub quality: crate::render::splat::Quality,
