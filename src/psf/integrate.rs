@@ -119,28 +119,24 @@ impl BoxIntegrator {
         self.kernel_with(&self.row_sums(), radius, scale)
     }
 
-    /// The running sums of every bin row along x, which kernels at every radius share: build
-    /// once per PSF, then ask [`Self::kernel_with`] for each radius.
+    /// The summed-area table of the bins, which kernels at every radius share: build once per
+    /// PSF, then ask [`Self::kernel_with`] for each radius.
     pub fn row_sums(&self) -> RowSums {
         let m = self.m;
-        let mut sums = vec![0.0f64; m * (m + 1)];
-        let mut nonzero = vec![false; m];
-        for ((row, f), nz) in self
-            .bins
-            .chunks(m)
-            .zip(sums.chunks_mut(m + 1))
-            .zip(nonzero.iter_mut())
-        {
-            *nz = row.iter().any(|v| *v != 0.0);
-            if *nz {
-                let mut acc = 0.0;
-                for (v, out) in row.iter().zip(&mut f[1..]) {
-                    acc += f64::from(*v);
-                    *out = acc;
-                }
+        // sat[j][i] = Σ_{q<j} Σ_{p<i} bins[q][p]: row j is the running sum along x of every
+        // bin row above it, i.e. the vertical running sum of the rows' running sums
+        let mut sat = vec![0.0f64; (m + 1) * (m + 1)];
+        for (q, row) in self.bins.chunks(m).enumerate() {
+            let (above, rest) = sat.split_at_mut((q + 1) * (m + 1));
+            let prev = &above[q * (m + 1)..];
+            let dst = &mut rest[..m + 1];
+            let mut acc = 0.0;
+            for i in 0..m {
+                acc += f64::from(row[i]);
+                dst[i + 1] = prev[i + 1] + acc;
             }
         }
-        RowSums { sums, nonzero }
+        RowSums { sat }
     }
 
     /// As [`Self::kernel`], from the integrator's [`Self::row_sums`]. A pixel's integral is
@@ -177,19 +173,29 @@ impl BoxIntegrator {
             })
             .collect();
         let m = self.m;
-        // running sums over bin rows of the x-integrated rows: G[r] = Σ_{q<r} tmp[q]
-        let mut g = vec![0.0f64; (m + 1) * side];
-        let mut acc = vec![0.0f64; side];
-        for (r, f) in row_sums.sums.chunks(m + 1).enumerate() {
-            if row_sums.nonzero[r] {
-                for (a, (lo, hi)) in acc.iter_mut().zip(&sx) {
-                    *a += between(f, lo, hi);
+        // G_j(u) = Σ_{q<j} ∫ row q over pixel column u: the summed-area table's row j read
+        // through pixel column u's stencils, needed only at the bin boundaries the rows'
+        // stencils touch (at most four per row edge), not at all m + 1
+        let clamp = |j: i64| j.clamp(0, m as i64) as usize;
+        let mut slot = vec![usize::MAX; m + 1];
+        let mut needed = Vec::new();
+        for ((ja, _), (jb, _)) in &sy {
+            for j in (0..4).flat_map(|k| [clamp(ja + k), clamp(jb + k)]) {
+                if slot[j] == usize::MAX {
+                    slot[j] = needed.len();
+                    needed.push(j);
                 }
             }
-            g[(r + 1) * side..(r + 2) * side].copy_from_slice(&acc);
+        }
+        let mut g = vec![0.0f64; needed.len() * side];
+        for (row, &j) in g.chunks_mut(side).zip(&needed) {
+            let h = &row_sums.sat[j * (m + 1)..(j + 1) * (m + 1)];
+            for (v, (lo, hi)) in row.iter_mut().zip(&sx) {
+                *v = between(h, lo, hi);
+            }
         }
         let mut out = vec![0.0f64; side * side];
-        let at = |j: i64| j.clamp(0, m as i64) as usize * side;
+        let at = |j: i64| slot[clamp(j)] * side;
         for (dst, ((ja, la), (jb, lb))) in out.chunks_mut(side).zip(&sy) {
             for k in 0..4 {
                 let (hi, lo) = (at(jb + k as i64), at(ja + k as i64));
@@ -228,11 +234,10 @@ impl BoxIntegrator {
     }
 }
 
-/// Running sums of an integrator's bin rows along x (row r: F_r(0) = 0 … F_r(m) = the row's
-/// total), and which rows hold anything.
+/// The summed-area table of an integrator's bins ((m + 1)², row j column i: the bins above
+/// row j and left of column i).
 pub struct RowSums {
-    sums: Vec<f64>,
-    nonzero: Vec<bool>,
+    sat: Vec<f64>,
 }
 
 /// F(hi) − F(lo) for a running sum `f` (constant beyond its ends) and two stencils.
