@@ -12,9 +12,10 @@
 # colonnade through the four preset eyes; `balanced` at 1280×720, then the old engine's default
 # there; colonnade off axis at 1280×720 (both presets); `fast` at 1280×720; `balanced` at
 # 1920×1080 and 3840×2160; the old engine at 3840×2160 (astigmatism, keratoconus); the draw
-# unshaded (`--draw-unshaded`, myopia, `fast`) at 3840×2160 and 1280×720. One JSON per
+# unshaded (`--draw-unshaded`, myopia, `fast`) at 3840×2160 and 1280×720, then at 2 and 8
+# samples per pixel (`--draw-samples`). One JSON per
 # run, named SCENE_EYE_SIZE[_off-axis]_{fast,balanced,old}; pairs are bin_SCENE_EYE_SIZE_fast,
-# the unshaded draws probe_SCENE_myopia_SIZE_fast.
+# the unshaded draws probe_SCENE_myopia_SIZE_fast, the others samplesN_SCENE_myopia_SIZE_fast.
 # Summarise with `tools/gpu_presets_table.py OUT_DIR`.
 #
 # Environment: FRAMES (timed frames, default 10), WARMUP (default 3), RUN_TIMEOUT_S (one run's
@@ -94,6 +95,15 @@ for size in 3840x2160 1280x720; do
     for scene in primitives colonnade; do
         run "probe_${scene}_myopia_${size}_fast" "$new" --scene "$scene" --eye myopia \
             --size "$size" --quality fast --draw-unshaded
+    done
+done
+# The draw at 2 and 8 samples per pixel (`--draw-samples`): how its time follows the samples.
+for size in 3840x2160 1280x720; do
+    for scene in primitives colonnade; do
+        for n in 2 8; do
+            run "samples${n}_${scene}_myopia_${size}_fast" "$new" --scene "$scene" --eye myopia \
+                --size "$size" --quality fast --draw-samples "$n"
+        done
     done
 done
 echo "gpu_presets: $((SECONDS - start)) s"

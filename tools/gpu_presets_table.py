@@ -98,9 +98,10 @@ def main():
         print(f"| {rep['scene']} | {rep['eye']} | {draw:.2f} + {splat:.2f} | "
               f"{b['gpu_total']['mean_ms']:.2f} | {b['wall_ms_per_pair']['mean_ms']:.2f} | "
               f"{b['gpu_ratio']:.2f}× |")
-    print("\nThe draw with and without its shading (`--draw-unshaded`; myopia, `fast`): raster ms\n")
-    print("| scene | size | shaded | unshaded |")
-    print("|---|---|---|---|")
+    print("\nThe draw with and without its shading (`--draw-unshaded`) and at 2 and 8 samples per "
+          "pixel (`--draw-samples`); myopia, `fast`: raster ms\n")
+    print("| scene | size | shaded | unshaded | 2 samples | 8 samples |")
+    print("|---|---|---|---|---|---|")
     for size in SIZES:
         for scene in ["primitives", "colonnade"]:
             probe = load(folder, f"probe_{scene}_myopia_{size}_fast")
@@ -108,7 +109,10 @@ def main():
             if probe is None or shaded is None:
                 continue
             raster = lambda r: next(p["mean_ms"] for p in r["passes"] if p["name"] == "raster")
-            print(f"| {scene} | {size} | {raster(shaded):.2f} | {raster(probe):.2f} |")
+            by_samples = [load(folder, f"samples{n}_{scene}_myopia_{size}_fast") for n in (2, 8)]
+            cells = ["—" if r is None else f"{raster(r):.2f}" for r in by_samples]
+            print(f"| {scene} | {size} | {raster(shaded):.2f} | {raster(probe):.2f} | "
+                  f"{cells[0]} | {cells[1]} |")
     print("\nWorst case per preset and size (GPU ms, draw included), and the draw's worst\n")
     for (name, size), (t, tag) in sorted(worst.items()):
         print(f"- {name} {size}: {t:.2f} ms ({tag})")

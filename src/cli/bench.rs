@@ -69,6 +69,10 @@ pub struct BenchArgs {
     /// resolving). The frame is not the scene's, and the splat's passes see other colours.
     #[arg(long)]
     pub draw_unshaded: bool,
+    /// A diagnostic of the draw: samples per pixel (2, 4 or 8; every frame uses 4), to see how
+    /// its time follows them. Edges and mixed pixels are only as fine as the samples.
+    #[arg(long, value_name = "N", value_parser = parse_draw_samples)]
+    pub draw_samples: Option<u32>,
     /// With --binocular: the right eye (a preset or an eye file); --eye is then the left.
     #[arg(long, value_name = "NAME|FILE")]
     pub eye_right: Option<String>,
@@ -141,6 +145,8 @@ struct Report {
     passes: Vec<Stat>,
     total: Stat,
     wall_ms_per_frame: Stat,
+    /// Wall minus GPU time per frame: what the host adds (reading the frame back above all).
+    host_ms_per_frame: Stat,
     list_entries: u64,
     /// Fragments left after merging (the splat's level of detail).
     live_fragments: u64,
@@ -170,6 +176,8 @@ struct Report {
     binocular: Option<super::bench_pair::PairBench>,
     /// `--draw-unshaded`: the draw shaded nothing (a diagnostic of its fixed-function cost).
     draw_unshaded: bool,
+    /// Samples per pixel the draw used (4 but under `--draw-samples`).
+    draw_samples: u32,
 }
 
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -201,6 +209,9 @@ struct TimedFrames {
     per_pass: Vec<(String, Vec<f64>)>,
     totals: Vec<f64>,
     walls: Vec<f64>,
+    /// Wall minus GPU time per frame: the host's share (recording, submitting, waiting on the
+    /// fence, reading the frame back).
+    hosts: Vec<f64>,
     list_entries: u64,
     live_fragments: u64,
     kernel_evaluations: u64,
@@ -298,6 +309,7 @@ fn time_frames(
         per_pass: Vec::new(),
         totals: Vec::with_capacity(args.frames),
         walls: Vec::with_capacity(args.frames),
+        hosts: Vec::with_capacity(args.frames),
         list_entries: 0,
         live_fragments: 0,
         kernel_evaluations: 0,
@@ -325,6 +337,7 @@ fn time_frames(
         }
         t.totals.push(timings.total_ms());
         t.walls.push(wall_ms);
+        t.hosts.push(wall_ms - timings.total_ms());
         if let Some(s) = out.stats {
             t.list_entries = s.list_entries;
             t.live_fragments = s.live_fragments;
@@ -408,6 +421,7 @@ impl Report {
             passes: timed.per_pass.iter().map(|(n, v)| stat(n, v)).collect(),
             total: stat("total", &timed.totals),
             wall_ms_per_frame: stat("wall", &timed.walls),
+            host_ms_per_frame: stat("host", &timed.hosts),
             list_entries: timed.list_entries,
             live_fragments: timed.live_fragments,
             kernel_evaluations: timed.kernel_evaluations,
@@ -423,8 +437,39 @@ impl Report {
             methods: Vec::new(),
             binocular: None,
             draw_unshaded: false,
+            draw_samples: crate::render::MSAA_SAMPLES,
         }
     }
+}
+
+fn parse_draw_samples(s: &str) -> std::result::Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(n @ (2 | 4 | 8)) => Ok(n),
+        _ => Err(format!("{s:?}: allowed 2, 4 or 8 samples per pixel")),
+    }
+}
+
+/// The rasteriser of a bench run: every frame's, or the draw's diagnostics (`--draw-unshaded`,
+/// `--draw-samples`).
+fn draw_rasterizer(ctx: &Context, args: &BenchArgs) -> Result<Rasterizer> {
+    use crate::render::{SurfaceInputs, MSAA_SAMPLES};
+    let inputs = if args.draw_unshaded {
+        println!("note: --draw-unshaded: the draw shades nothing; only its time is meaningful");
+        SurfaceInputs::Unshaded
+    } else {
+        SurfaceInputs::Covered
+    };
+    let samples = args.draw_samples.unwrap_or(MSAA_SAMPLES);
+    if samples != MSAA_SAMPLES {
+        println!("note: --draw-samples {samples}: edges are not every frame's; time the draw only");
+    }
+    Rasterizer::with_samples(ctx, inputs, samples).map_err(|e| {
+        if samples == MSAA_SAMPLES {
+            e
+        } else {
+            Error::input(format!("--draw-samples {samples}: {e}"))
+        }
+    })
 }
 
 /// Checks the options that need no device, and the report's path, before minutes of
@@ -490,12 +535,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     let runs = 1 + usize::from(args.baseline) + usize::from(args.binocular);
     let bar = super::frame_progress_bar((runs * (args.warmup + args.frames)) as u64);
     let scene_state = scene.at_time(0.0);
-    let mut raster = if args.draw_unshaded {
-        println!("note: --draw-unshaded: the draw shades nothing; only its time is meaningful");
-        Rasterizer::with_inputs(&ctx, crate::render::SurfaceInputs::Unshaded)?
-    } else {
-        Rasterizer::new(&ctx)?
-    };
+    let mut raster = draw_rasterizer(&ctx, args)?;
     let mut scene_input = SceneInput {
         ctx: &ctx,
         raster: &mut raster,
@@ -568,6 +608,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     );
     (report.baseline, report.methods, report.binocular) = (baseline, methods, binocular);
     report.draw_unshaded = args.draw_unshaded;
+    report.draw_samples = args.draw_samples.unwrap_or(crate::render::MSAA_SAMPLES);
     write_report(&report, args, outputs)
 }
 
@@ -732,6 +773,11 @@ fn print_table(r: &Report) {
     println!(
         "  {:<22} {:>10.3} {:>10.3} {:>10.3}   (CPU wall, upload and read-back included)",
         "wall per frame", w.mean_ms, w.median_ms, w.p95_ms
+    );
+    let h = &r.host_ms_per_frame;
+    println!(
+        "  {:<22} {:>10.3} {:>10.3} {:>10.3}   (wall − GPU: recording, waiting, read-back)",
+        "host per frame", h.mean_ms, h.median_ms, h.p95_ms
     );
     let c = &r.counters;
     println!(

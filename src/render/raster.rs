@@ -208,6 +208,8 @@ pub struct Rasterizer {
     view_magnification: [[f64; 2]; 2],
     /// Whether the visible layer's resolve also writes its mixed pixels (`Frame::rest`).
     mixed_pixels: bool,
+    /// Samples per pixel ([`MSAA_SAMPLES`] but for the draw's timing diagnostic).
+    samples: u32,
 }
 
 impl Rasterizer {
@@ -219,8 +221,20 @@ impl Rasterizer {
     /// [`SurfaceInputs::Covered`] renders correctly; the other exists as the silhouette test's
     /// negative control.
     pub fn with_inputs(ctx: &Context, inputs: SurfaceInputs) -> Result<Rasterizer> {
-        let pipeline = Self::pipeline(ctx, false, inputs)?;
-        let peel = Self::pipeline(ctx, true, SurfaceInputs::Covered)?;
+        Self::with_samples(ctx, inputs, MSAA_SAMPLES)
+    }
+
+    /// As [`Self::with_inputs`], with `samples` per pixel (2, 4 or 8) where every frame uses
+    /// [`MSAA_SAMPLES`]: a timing diagnostic (`ocular bench --draw-samples`), since coverage
+    /// and mixed pixels are only as fine as the samples.
+    pub fn with_samples(ctx: &Context, inputs: SurfaceInputs, samples: u32) -> Result<Rasterizer> {
+        if ![2, 4, 8].contains(&samples) {
+            return Err(crate::Error::input(format!(
+                "raster samples per pixel: {samples}; allowed: 2, 4 or 8"
+            )));
+        }
+        let pipeline = Self::pipeline(ctx, false, inputs, samples)?;
+        let peel = Self::pipeline(ctx, true, SurfaceInputs::Covered, samples)?;
         let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
             .push_constants::<ResolvePush>()
             .build(ctx)?;
@@ -250,12 +264,18 @@ impl Rasterizer {
             )?,
             view_magnification: [[1.0, 0.0], [0.0, 1.0]],
             mixed_pixels: false,
+            samples,
         })
     }
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
     /// layer's samples, `previous_samples` in glsl/render/raster_peel.frag).
-    fn pipeline(ctx: &Context, peel: bool, inputs: SurfaceInputs) -> Result<GraphicsPipeline> {
+    fn pipeline(
+        ctx: &Context,
+        peel: bool,
+        inputs: SurfaceInputs,
+        samples: u32,
+    ) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
         let (name, fragment) = match (peel, inputs) {
             (true, _) => ("raster peel", crate::shaders::RENDER_RASTER_PEEL_FRAG),
@@ -297,7 +317,7 @@ impl Rasterizer {
                     ],
                 )
                 .push_constants::<MaterialPush>()
-                .samples(MSAA_SAMPLES)
+                .samples(samples)
                 .color_target(TexelFormat::Rgba32Float, true)
                 .color_target(TexelFormat::R32Float, false)
                 .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
@@ -367,17 +387,17 @@ impl Rasterizer {
         let color_ms = target(
             "raster colour (MSAA)",
             TexelFormat::Rgba32Float,
-            attachment(false, self.mixed_pixels, MSAA_SAMPLES),
+            attachment(false, self.mixed_pixels, self.samples),
         )?;
         let view_depth_ms = target(
             "raster view depth (MSAA)",
             TexelFormat::R32Float,
-            attachment(false, true, MSAA_SAMPLES),
+            attachment(false, true, self.samples),
         )?;
         let depth_ms = target(
             "raster depth buffer (MSAA)",
             TexelFormat::D32Float,
-            attachment(true, false, MSAA_SAMPLES),
+            attachment(true, false, self.samples),
         )?;
         // storage: splat's input pass reads it where the frame stays on the GPU
         let color = target(
@@ -442,7 +462,7 @@ impl Rasterizer {
                 storage: false,
                 color_attachment: true,
                 depth_attachment: false,
-                samples: MSAA_SAMPLES,
+                samples: self.samples,
             },
         )?;
         let framebuffer = |view_depth: &Image| {
@@ -813,7 +833,7 @@ impl Rasterizer {
             .push(&ResolvePush {
                 width,
                 height,
-                samples: MSAA_SAMPLES,
+                samples: self.samples,
                 split: u32::from(layer == 0 && self.mixed_pixels),
                 group_tolerance_d: crate::render::blend::DEFAULT_GROUP_TOLERANCE_D,
             })

@@ -334,6 +334,15 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
     }
     assert_eq!(report["frames"], 3);
     assert!(report["device"].as_str().is_some_and(|d| !d.is_empty()));
+    // the host's share is reported apart: per frame, wall minus GPU time, so the means add up
+    let host = report["host_ms_per_frame"]["mean_ms"].as_f64().unwrap();
+    let wall = report["wall_ms_per_frame"]["mean_ms"].as_f64().unwrap();
+    assert!(
+        (host + total - wall).abs() <= 1e-6 * wall.max(1.0),
+        "{host} + {total} vs {wall}"
+    );
+    // it holds the frame's read-back, at least the 160 × 90 × 16 bytes of colour
+    assert!(host > 0.0, "{host}");
 }
 
 /// A peeled scene (`--layers 2`) stays on the GPU in bench and render: bench's steady frame
@@ -535,4 +544,20 @@ fn render_uses_the_scene_resolution() {
             .arg(&out),
     );
     assert_eq!(png_size(&out), (72, 40));
+}
+
+#[test]
+fn bench_refuses_a_sample_count_the_draw_cannot_take() {
+    for bad in ["3", "1", "x"] {
+        let out = ocular()
+            .args(["bench", "--draw-samples", bad])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {err}");
+        assert!(
+            err.contains("--draw-samples") && err.contains("2, 4 or 8"),
+            "{err}"
+        );
+    }
 }

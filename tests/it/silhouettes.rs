@@ -364,3 +364,46 @@ fn the_unshaded_draw_keeps_the_depths_and_drops_the_lighting() {
     drop((shaded, unshaded));
     common::finish(ctx);
 }
+
+/// `bench --draw-samples` times the draw at 2 or 8 samples per pixel: inside surfaces the
+/// frame is every frame's (a covered pixel's centroid is its centre whatever the samples),
+/// only pixels that edges cross change, and other counts are refused.
+#[test]
+fn the_draw_at_other_sample_counts_changes_only_edge_pixels() {
+    let ctx = common::gpu();
+    let s = test_scene([0.3, -0.5, -1.0]);
+    let size = (320, 180);
+    let four = render(&mut Rasterizer::new(&ctx).unwrap(), &ctx, &s, size);
+    for samples in [2, 8] {
+        let mut r = match Rasterizer::with_samples(&ctx, SurfaceInputs::Covered, samples) {
+            Ok(r) => r,
+            // lavapipe multisamples at 4 only (Vulkan requires 1 and 4 of a device)
+            Err(e) if e.to_string().contains("does not support") => {
+                eprintln!("{samples} samples: not on this device ({e})");
+                continue;
+            }
+            Err(e) => panic!("{samples} samples: {e}"),
+        };
+        let other = render(&mut r, &ctx, &s, size);
+        let same = four
+            .color
+            .iter()
+            .zip(&other.color)
+            .zip(four.depth_m.iter().zip(&other.depth_m))
+            .filter(|((p, q), (d, e))| p == q && d == e)
+            .count();
+        let pixels = four.color.len();
+        eprintln!(
+            "{samples} samples: {} of {pixels} pixels differ",
+            pixels - same
+        );
+        // the test scene's silhouettes cross about 2 % of its pixels
+        assert!(same * 100 >= pixels * 95, "{samples}: {same} of {pixels}");
+        assert!(same < pixels, "{samples} samples changed no edge");
+        drop(r);
+    }
+    for samples in [1, 3, 16] {
+        assert!(Rasterizer::with_samples(&ctx, SurfaceInputs::Covered, samples).is_err());
+    }
+    common::finish(ctx);
+}
