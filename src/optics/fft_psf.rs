@@ -98,7 +98,8 @@ pub fn psf_by_fft(
     let k2pi = 2.0 * PI / (wavelength_nm * 1e-3);
     // single precision: the amplitude's rounding (~1e-7 of its peak) is far below
     // anything a kernel (stored as f32) can show
-    let plan = FftPlanner::<f32>::new().plan_fft_inverse(n);
+    // one planner per thread: a grid's PSFs share a few lengths, whose plans it keeps
+    let plan = PLANNER.with(|p| p.borrow_mut().plan_fft_inverse(n));
     let mut scratch = vec![Complex32::default(); plan.get_inplace_scratch_len()];
     let rows = (2 * a_max + 1) as usize;
     // the FFT bin of pupil offset −a_max..=a_max (rows and columns alike), and of output
@@ -169,9 +170,20 @@ pub fn psf_by_fft(
         let count = BLOCK.min(size - first);
         for j in 0..count {
             let k = first + j;
-            buf.iter_mut().for_each(|c| *c = Complex32::default());
-            for (&p, t) in pupil_bins.iter().zip(&tmp[k * rows..(k + 1) * rows]) {
-                buf[p] += *t;
+            let column = &tmp[k * rows..(k + 1) * rows];
+            if rows < n {
+                // the rows' bins are distinct, 0..=a_max and n − a_max..n: write them, and
+                // clear only the bins between
+                buf[a_max as usize + 1..n - a_max as usize].fill(Complex32::default());
+                for (&p, t) in pupil_bins.iter().zip(column) {
+                    buf[p] = *t;
+                }
+            } else {
+                // a pupil wider than the period folds onto itself: the DFT sums it
+                buf.fill(Complex32::default());
+                for (&p, t) in pupil_bins.iter().zip(column) {
+                    buf[p] += *t;
+                }
             }
             plan.process_with_scratch(&mut buf, &mut scratch);
             let col = &mut block[j * size..(j + 1) * size];
@@ -189,6 +201,10 @@ pub fn psf_by_fft(
         }
     }
     Ok(out)
+}
+
+thread_local! {
+    static PLANNER: std::cell::RefCell<FftPlanner<f32>> = std::cell::RefCell::new(FftPlanner::new());
 }
 
 /// Rows (first pass) or columns (second pass) transformed before their results are written
