@@ -35,24 +35,8 @@ start=$SECONDS
 status=0
 eyes="healthy myopia astigmatism keratoconus"
 
-# One bench run: NAME, BINARY, then bench arguments.
-run() {
-    local name=$1 bin=$2
-    shift 2
-    if [ "$deadline" -gt 0 ] && [ $((SECONDS - start)) -ge "$deadline" ]; then
-        echo "== $name skipped: past DEADLINE_S=$deadline"
-        status=1
-        return
-    fi
-    if ! timeout "$run_timeout" "$bin" bench "$@" --warmup "$warmup" --frames "$frames" \
-        --json "$out/$name.json" > "$out/$name.log" 2>&1; then
-        echo "== $name failed or over ${run_timeout} s: $(tail -n 1 "$out/$name.log")"
-        rm -f "$out/$name.json"
-        status=1
-    else
-        echo "== $name ($((SECONDS - start)) s): $(grep -E '^  total' "$out/$name.log" | head -n 2 | tr '\n' ' ')"
-    fi
-}
+# run NAME BINARY ARGS...: one bench run (tools/gpu_run.sh)
+source "$(dirname "${BASH_SOURCE[0]}")/gpu_run.sh"
 
 # NAME_SUFFIX QUALITY|old SIZES SCENES [EYES] [extra bench arguments...]
 sweep() {

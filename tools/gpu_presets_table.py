@@ -8,27 +8,15 @@ and the splat (every other pass), its wall time per frame (upload and read-back 
 its texture reads per pixel; the old engine's total where it ran. Then the two-eye runs. Every
 number is read from the `ocular bench --json` reports; only sums, maxima and ratios are computed.
 """
-import json
 import os
 import sys
 
-DRAW = {"raster", "depth resolve", "peel"}
+# the draw's passes, and reading and splitting a report: gpu_vs_old_table.py's
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gpu_vs_old_table import load, split  # noqa: E402
+
 EYES = ["healthy", "myopia", "astigmatism", "keratoconus"]
 SIZES = ["1280x720", "1920x1080", "3840x2160"]
-
-
-def load(folder, name):
-    path = os.path.join(folder, name + ".json")
-    if not os.path.exists(path):
-        return None
-    with open(path) as f:
-        return json.load(f)
-
-
-def split(report):
-    draw = sum(p["mean_ms"] for p in report["passes"] if p["name"] in DRAW)
-    splat = sum(p["mean_ms"] for p in report["passes"] if p["name"] not in DRAW)
-    return draw, splat
 
 
 def cell(report):

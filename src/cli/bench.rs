@@ -443,10 +443,12 @@ impl Report {
 }
 
 fn parse_draw_samples(s: &str) -> std::result::Result<u32, String> {
-    match s.trim().parse::<u32>() {
-        Ok(n @ (2 | 4 | 8)) => Ok(n),
-        _ => Err(format!("{s:?}: allowed 2, 4 or 8 samples per pixel")),
-    }
+    use crate::render::RASTER_SAMPLE_COUNTS;
+    s.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|n| RASTER_SAMPLE_COUNTS.contains(n))
+        .ok_or_else(|| "allowed 2, 4 or 8 samples per pixel".to_string())
 }
 
 /// The rasteriser of a bench run: every frame's, or the draw's diagnostics (`--draw-unshaded`,

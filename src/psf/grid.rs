@@ -365,7 +365,7 @@ pub(crate) fn grid_from_psfs(
             .for_each(|(o, blocks)| {
                 for c in 0..3 {
                     let Some(p) = psf(s, c, o) else { continue };
-                    let sums = p.bins.row_sums();
+                    let sums = p.bins.summed_area();
                     for (level, block) in blocks.iter_mut() {
                         let radius = level_block_radius(*level);
                         // the natural half-width spans r + ½ px: pixels of half_samples / (r + ½)

@@ -116,12 +116,12 @@ impl BoxIntegrator {
     /// Kernel of integer `radius` whose pixels are `scale` samples wide, in screen orientation
     /// (rows reversed: screen y is down, the PSF grid's +y up), normalised to sum 1.
     pub fn kernel(&self, radius: u32, scale: f64) -> Vec<f64> {
-        self.kernel_with(&self.row_sums(), radius, scale)
+        self.kernel_with(&self.summed_area(), radius, scale)
     }
 
     /// The summed-area table of the bins, which kernels at every radius share: build once per
     /// PSF, then ask [`Self::kernel_with`] for each radius.
-    pub fn row_sums(&self) -> RowSums {
+    pub fn summed_area(&self) -> SummedArea {
         let m = self.m;
         // sat[j][i] = Σ_{q<j} Σ_{p<i} bins[q][p]: row j is the running sum along x of every
         // bin row above it, i.e. the vertical running sum of the rows' running sums
@@ -136,14 +136,15 @@ impl BoxIntegrator {
                 dst[i + 1] = prev[i + 1] + acc;
             }
         }
-        RowSums { sat }
+        SummedArea { sat }
     }
 
-    /// As [`Self::kernel`], from the integrator's [`Self::row_sums`]. A pixel's integral is
+    /// As [`Self::kernel`], from the integrator's [`Self::summed_area`]. A pixel's integral is
     /// F(hi) − F(lo), F the running integral interpolated by a cubic through the four nearest
-    /// bin boundaries: read from running sums, each costs eight reads whatever the pixel's
-    /// width, first along x per bin row, then along y over the running sums of that result.
-    pub fn kernel_with(&self, row_sums: &RowSums, radius: u32, scale: f64) -> Vec<f64> {
+    /// bin boundaries: read from the summed-area table, each costs eight reads whatever the
+    /// pixel's width, first along x on the table rows the pixel rows' stencils touch, then
+    /// along y over those results.
+    pub fn kernel_with(&self, summed_area: &SummedArea, radius: u32, scale: f64) -> Vec<f64> {
         let side = 2 * radius as usize + 1;
         let delta = || {
             let mut v = vec![0.0; side * side];
@@ -189,7 +190,7 @@ impl BoxIntegrator {
         }
         let mut g = vec![0.0f64; needed.len() * side];
         for (row, &j) in g.chunks_mut(side).zip(&needed) {
-            let h = &row_sums.sat[j * (m + 1)..(j + 1) * (m + 1)];
+            let h = &summed_area.sat[j * (m + 1)..(j + 1) * (m + 1)];
             for (v, (lo, hi)) in row.iter_mut().zip(&sx) {
                 *v = between(h, lo, hi);
             }
@@ -236,7 +237,7 @@ impl BoxIntegrator {
 
 /// The summed-area table of an integrator's bins ((m + 1)², row j column i: the bins above
 /// row j and left of column i).
-pub struct RowSums {
+pub struct SummedArea {
     sat: Vec<f64>,
 }
 

@@ -24,7 +24,7 @@ pub(crate) mod timeline;
 pub mod views;
 
 // Rasterising a scene into colour and depth.
-pub use raster::{Frame, Rasterizer, SurfaceInputs, MSAA_SAMPLES};
+pub use raster::{Frame, Rasterizer, SurfaceInputs, MSAA_SAMPLES, RASTER_SAMPLE_COUNTS};
 // How layers of fragments are blended.
 pub use blend::{BlendMode, BlendSettings, EdgePixels, DEFAULT_GROUP_TOLERANCE_D};
 // One frame from a scene and an eye: its kernels and its renderer.

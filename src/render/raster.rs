@@ -41,6 +41,9 @@ pub enum SurfaceInputs {
 /// Samples per pixel.
 pub const MSAA_SAMPLES: u32 = 4;
 
+/// Samples per pixel [`Rasterizer::with_samples`] takes (a device may have fewer).
+pub const RASTER_SAMPLE_COUNTS: [u32; 3] = [2, 4, 8];
+
 /// Depth layers a scene is peeled to for splat unless told otherwise (docs/validation.md).
 pub const DEFAULT_LAYERS: u32 = 1;
 
@@ -228,7 +231,7 @@ impl Rasterizer {
     /// [`MSAA_SAMPLES`]: a timing diagnostic (`ocular bench --draw-samples`), since coverage
     /// and mixed pixels are only as fine as the samples.
     pub fn with_samples(ctx: &Context, inputs: SurfaceInputs, samples: u32) -> Result<Rasterizer> {
-        if ![2, 4, 8].contains(&samples) {
+        if !RASTER_SAMPLE_COUNTS.contains(&samples) {
             return Err(crate::Error::input(format!(
                 "raster samples per pixel: {samples}; allowed: 2, 4 or 8"
             )));
