@@ -19,7 +19,7 @@ use crate::render::Rasterizer;
 use crate::scene::{FrameState, Scene};
 use crate::{Error, Result};
 
-#[derive(Debug, Args)]
+#[derive(Clone, Debug, Args)]
 #[command(after_help = "Examples:\n  \
     ocular bench --scene primitives --eye myopia --size 1280x720\n  \
     ocular bench --scene colonnade --eye keratoconus --frames 20 --compare-methods --json bench.json\n\n\
@@ -35,6 +35,11 @@ pub struct BenchArgs {
     /// Frame size.
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "1280x720")]
     pub size: (u32, u32),
+    /// Time each eye's frame at a headset's panel size and vertical field (the scene's camera
+    /// takes the headset's field): quest3 (2064×2208, 96°), vive-pro (1440×1600, 110°). With
+    /// --binocular the report sets the pair against the headset's refresh interval.
+    #[arg(long, value_enum, conflicts_with = "size")]
+    pub headset: Option<crate::render::headset::Headset>,
     /// Frames rendered before timing starts (shader compilation, caches).
     #[arg(long, default_value_t = 5)]
     pub warmup: usize,
@@ -174,6 +179,9 @@ struct Report {
     methods: Vec<MethodTime>,
     /// `--binocular`: both eyes' cost, beside this one eye's.
     binocular: Option<super::bench_pair::PairBench>,
+    /// `--headset`: the panel and field each eye was timed at, and the refresh interval.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    headset: Option<crate::render::headset::HeadsetSummary>,
     /// `--draw-unshaded`: the draw shaded nothing (a diagnostic of its fixed-function cost).
     draw_unshaded: bool,
     /// Samples per pixel the draw used (4 but under `--draw-samples`).
@@ -436,6 +444,7 @@ impl Report {
             baseline: None,
             methods: Vec::new(),
             binocular: None,
+            headset: None,
             draw_unshaded: false,
             draw_samples: crate::render::MSAA_SAMPLES,
         }
@@ -505,14 +514,14 @@ fn per_pixel(count: u64, (width, height): (u32, u32)) -> f64 {
 }
 
 pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
+    let (args, scene) = &headset_frame(args)?;
     let outputs = checked_outputs(args)?;
     let mut splat = args.splat.settings()?;
     let eye = load_eye(&args.eye)?;
-    let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
     let width = args.size.0;
     let (frame, eye_state, screen) =
-        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm, false)?;
+        super::measured_scene_frame(&ctx, scene, args.size, args.pupil_mm, false)?;
     // the white `render` would show this frame at, as the unit of the merge's colour bound
     splat.merge.white = crate::render::splat::display_white(
         crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color),
@@ -609,9 +618,26 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
         &timed,
     );
     (report.baseline, report.methods, report.binocular) = (baseline, methods, binocular);
+    report.headset = args.headset.map(|h| h.summary());
     report.draw_unshaded = args.draw_unshaded;
     report.draw_samples = args.draw_samples.unwrap_or(crate::render::MSAA_SAMPLES);
     write_report(&report, args, outputs)
+}
+
+/// The options and scene as `--headset` (if any) makes them: its panel for the frame's size,
+/// its vertical field for the scene's camera.
+fn headset_frame(args: &BenchArgs) -> Result<(BenchArgs, Scene)> {
+    let scene = Scene::load(&args.scene)?;
+    Ok(match args.headset.map(|h| h.spec()) {
+        Some(h) => (
+            BenchArgs {
+                size: h.size(),
+                ..args.clone()
+            },
+            scene.with_fov_y_deg(h.fov_y_deg),
+        ),
+        None => (args.clone(), scene),
+    })
 }
 
 /// Prints the report and writes its JSON where asked.
@@ -619,6 +645,9 @@ fn write_report(report: &Report, args: &BenchArgs, outputs: super::outputs::Outp
     print_table(report);
     if let Some(p) = &report.binocular {
         super::bench_pair::print(p);
+    }
+    if let Some(h) = &report.headset {
+        print_headset(h, report);
     }
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(report)
@@ -630,6 +659,32 @@ fn write_report(report: &Report, args: &BenchArgs, outputs: super::outputs::Outp
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The headset's line: each eye's frame, and the frame (or pair) against its refresh interval.
+fn print_headset(h: &crate::render::headset::HeadsetSummary, report: &Report) {
+    let (what, gpu_ms) = match &report.binocular {
+        Some(p) => ("both eyes", p.gpu_total.mean_ms),
+        None => ("one eye", report.total.mean_ms),
+    };
+    println!();
+    println!(
+        "{}: {}×{} per eye, {:.1}° × {:.1}°; {what} take {gpu_ms:.3} ms of GPU time against \
+         {:.1} ms at {} Hz ({:.2}× the budget{})",
+        h.name,
+        h.width_px,
+        h.height_px,
+        h.fov_x_deg,
+        h.fov_y_deg,
+        h.frame_budget_ms,
+        h.refresh_hz,
+        gpu_ms / h.frame_budget_ms,
+        if report.binocular.is_none() {
+            "; add --binocular for the pair"
+        } else {
+            ""
+        }
+    );
 }
 
 /// The splatting settings before this work: the seed paper's blend and narrow field, no

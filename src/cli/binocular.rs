@@ -17,7 +17,6 @@ use crate::render::frame::HostFrame;
 use crate::render::frame::Method;
 use crate::render::frame_plan::{Correction, IolPower};
 use crate::render::live::{LiveOptions, LiveRenderer};
-use crate::scene::Scene;
 use crate::{Error, Result};
 
 /// How a binocular pair is written.
@@ -130,6 +129,9 @@ struct Summary {
     scene: String,
     width: u32,
     height: u32,
+    /// `--headset`: each eye's panel and field, and the refresh interval both frames share.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    headset: Option<crate::render::headset::HeadsetSummary>,
     /// Scene pairs only (a file pair's camera separation is its renderer's).
     ipd_mm: Option<f64>,
     fixation_m: Option<[f64; 3]>,
@@ -222,10 +224,8 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         }
         None => {
             let name = args.scene.clone().unwrap_or_else(|| "primitives".into());
-            let scene = Arc::new(Scene::load(&name)?);
-            let size = args
-                .size
-                .unwrap_or((scene.resolution[0], scene.resolution[1]));
+            let (scene, size) = super::render::scene_and_size(args, &name)?;
+            let scene = Arc::new(scene);
             let pair = binocular::render_pair(
                 &live,
                 &PairRequest {
@@ -254,7 +254,8 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
         (&files, &paths),
     )?;
     files.commit()?;
-    let summary = summarize(&pair, &specs, name, size, (stereo, &paths), live.device());
+    let mut summary = summarize(&pair, &specs, name, size, (stereo, &paths), live.device());
+    summary.headset = args.headset.map(|h| h.summary());
     if args.json {
         println!("{}", super::eye::json(&summary)?);
         return Ok(());
@@ -309,6 +310,7 @@ fn summarize(
         scene: name,
         width: size.0,
         height: size.1,
+        headset: None,
         ipd_mm: geometry.map(|g| g.ipd_m * 1e3),
         fixation_m: pair.fixation_m,
         fixation_from: pair.fixation_from.clone(),
@@ -400,6 +402,20 @@ fn print(s: &Summary) {
             s.pupil_mm,
             s.pupil_source,
         ),
+    }
+    if let Some(h) = &s.headset {
+        println!(
+            "  each eye as the {} shows it: {}×{}, {:.1}° × {:.1}° ({:.2} px/° at the centre), \
+             both within {:.1} ms at {} Hz",
+            h.name,
+            h.width_px,
+            h.height_px,
+            h.fov_x_deg,
+            h.fov_y_deg,
+            h.preset.spec().centre_px_per_deg(),
+            h.frame_budget_ms,
+            h.refresh_hz
+        );
     }
     println!(
         "  accommodation {:.2} D, driven by the {} eye",

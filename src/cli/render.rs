@@ -26,7 +26,8 @@ use crate::{Error, Result};
     ocular render --color c.exr --depth d.exr --fov-y 60 --eye astigmatism --focus-m 7.5 --pupil-mm 5 -o out.exr\n  \
     ocular render --color blender.exr --fov-y 22.9 --eye myopia          # Combined + Depth.Z of one file\n  \
     ocular render --color photo.png --depth d.exr --fov-y 40 --white-cdm2 200\n  \
-    ocular render --scene colonnade --focus-at 320,180 --luminance-cdm2 30 --timings\n\n\
+    ocular render --scene colonnade --focus-at 320,180 --luminance-cdm2 30 --timings\n  \
+    ocular render --scene chart --binocular --headset quest3 --stereo side-by-side -o vr.png\n\n\
 Focus: --focus-m/--focus-d, or --focus-at X,Y (the depth under that pixel), else the scene's \
 focus, else the depth at the frame's centre; background is infinitely far and focus distances \
 from 1e4 m on are infinity. Pupil: --pupil-mm, else from --luminance-cdm2, the \
@@ -157,6 +158,11 @@ pub struct RenderArgs {
     /// shipped scenes); colour/depth files keep their own size.
     #[arg(long, value_name = "WxH", value_parser = parse_size, conflicts_with = "color")]
     pub size: Option<(u32, u32)>,
+    /// Render each eye's frame at a headset's panel size and vertical field (scenes only; with
+    /// --binocular, both eyes): quest3 (2064×2208, 96°), vive-pro (1440×1600, 110°).
+    /// docs/binocular.md gives the published figures.
+    #[arg(long, value_enum, conflicts_with_all = ["size", "color"])]
+    pub headset: Option<crate::render::headset::Headset>,
     /// Scene time in seconds (keyframes).
     #[arg(long, value_name = "SECONDS", default_value_t = 0.0)]
     pub time: f64,
@@ -313,6 +319,21 @@ fn check_file_options(args: &RenderArgs) -> Result<()> {
     }
 }
 
+/// The scene `name` as `--headset` (if any) shows it, and the frame size: the headset's panel,
+/// else `--size`, else the scene's own.
+pub fn scene_and_size(args: &RenderArgs, name: &str) -> Result<(Scene, (u32, u32))> {
+    let scene = Scene::load(name)?;
+    Ok(match args.headset.map(|h| h.spec()) {
+        Some(h) => (scene.with_fov_y_deg(h.fov_y_deg), h.size()),
+        None => {
+            let size = args
+                .size
+                .unwrap_or((scene.resolution[0], scene.resolution[1]));
+            (scene, size)
+        }
+    })
+}
+
 fn check_fov(fov_y_deg: f64) -> Result<()> {
     crate::limits::FOV_Y_DEG
         .check("--fov-y", fov_y_deg)
@@ -418,7 +439,7 @@ fn load_input(
         .scene
         .clone()
         .unwrap_or_else(|| "primitives".to_string());
-    let scene = Scene::load(&name)?;
+    let (scene, (width, height)) = scene_and_size(args, &name)?;
     if !args.time.is_finite() || args.time < 0.0 {
         return Err(Error::input(format!(
             "--time {} must be a non-negative number of seconds",
@@ -426,9 +447,6 @@ fn load_input(
         )));
     }
     let state = scene.at_time(args.time);
-    let (width, height) = args
-        .size
-        .unwrap_or((scene.resolution[0], scene.resolution[1]));
     let mut rasterizer = Rasterizer::new(ctx)?;
     let mut warnings = Vec::new();
     // The world seen through the spectacle: its angular magnification moves every direction.
@@ -543,7 +561,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     splat.merge.white =
         crate::render::splat::display_white(super::render_output::exposure_ev(args, &input));
     if args.method == Method::Views {
-        let scene = Scene::load(args.scene.as_deref().unwrap_or("primitives"))?;
+        let (scene, _) = scene_and_size(args, args.scene.as_deref().unwrap_or("primitives"))?;
         let frame = super::occlusion::render_views(
             &ctx,
             &scene.at_time(args.time),

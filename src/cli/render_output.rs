@@ -14,6 +14,9 @@ pub(super) struct Summary {
     width: u32,
     height: u32,
     fov_y_deg: f64,
+    /// `--headset`: the panel and field the frame was rendered at.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    headset: Option<crate::render::headset::HeadsetSummary>,
     /// Where the depth came from (file input only).
     depth: Option<String>,
     /// Background, invalid, clamped and constant depth (file input only).
@@ -107,6 +110,7 @@ pub(super) fn finish(
         width: input.frame.width,
         height: input.frame.height,
         fov_y_deg: input.frame.fov_y_deg,
+        headset: args.headset.map(|h| h.summary()),
         depth: input.depth_source.clone(),
         depth_report: input.depth_report.clone(),
         focus_d,

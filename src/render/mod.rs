@@ -12,6 +12,7 @@ pub(crate) mod edge_band;
 pub(crate) mod focus;
 pub(crate) mod frame;
 pub mod frame_plan;
+pub mod headset;
 pub(crate) mod judge;
 pub mod live;
 pub(crate) mod projection;

@@ -155,6 +155,15 @@ impl Scene {
         )))
     }
 
+    /// The scene seen through a camera of another vertical field (a headset's): the field is
+    /// fixed at `fov_y_deg` for the whole animation (a keyframed field is dropped), and
+    /// everything else is kept.
+    pub fn with_fov_y_deg(mut self, fov_y_deg: f64) -> Scene {
+        self.base_camera.fov_y_deg = fov_y_deg;
+        self.timeline.fov_y_deg = Track::default();
+        self
+    }
+
     pub fn from_file(path: &Path) -> Result<Scene> {
         let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
             std::io::ErrorKind::NotFound => Error::file(path, "scene file not found"),
