@@ -17,14 +17,19 @@ use super::guarded;
 use crate::gpu::{Context, ContextOptions};
 use crate::render::frame::HostFrame;
 use crate::render::frame_plan::SceneEye;
+use crate::render::headset::Headset;
 use crate::render::live::{LiveRenderer, SceneArg};
 use crate::scene::Scene;
+use std::sync::Arc;
 
 /// Renders colour + depth frames (and scenes) as an eye sees them on one Vulkan device.
 #[pyclass(name = "Renderer", module = "ocular_render")]
 pub struct PyRenderer {
     live: LiveRenderer,
     last_pair: std::sync::Mutex<Option<PairReport>>,
+    /// The last scene seen through a headset's field (`headset=`), kept so that its frames
+    /// and geometry stay cached while it is asked for again.
+    headset_scene: std::sync::Mutex<Option<(String, Headset, Arc<Scene>)>>,
 }
 
 /// How the last binocular pair was rendered, for `Renderer.last_pair`.
@@ -37,6 +42,45 @@ struct PairReport {
     far_point_d: [f64; 2],
     demand_d: [f64; 2],
     pupil_mm: f64,
+}
+
+/// `headset=`: a preset name (as `--headset` takes it), refused beside `size`.
+fn parse_headset(name: Option<&str>, size: Option<(u32, u32)>) -> PyResult<Option<Headset>> {
+    let Some(name) = name else {
+        return Ok(None);
+    };
+    if size.is_some() {
+        return Err(super::value_error(
+            "headset= sets the frame's size: give headset or size, not both",
+        ));
+    }
+    use clap::ValueEnum;
+    Headset::from_str(name, true).map(Some).map_err(|_| {
+        let names: Vec<String> = Headset::value_variants()
+            .iter()
+            .filter_map(|h| h.to_possible_value().map(|v| v.get_name().to_string()))
+            .collect();
+        super::value_error(format!(
+            "headset={name:?}: no such headset ({})",
+            names.join(", ")
+        ))
+    })
+}
+
+impl PyRenderer {
+    /// The scene `name` through `headset`'s vertical field, loaded once and kept while asked
+    /// for again (a new one is a new scene to the renderer's caches).
+    fn headset_scene(&self, name: &str, headset: Headset) -> crate::Result<Arc<Scene>> {
+        let mut kept = self.headset_scene.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some((n, h, scene)) = kept.as_ref() {
+            if n == name && *h == headset {
+                return Ok(Arc::clone(scene));
+            }
+        }
+        let scene = Arc::new(Scene::load(name)?.with_fov_y_deg(headset.spec().fov_y_deg));
+        *kept = Some((name.to_string(), headset, Arc::clone(&scene)));
+        Ok(scene)
+    }
 }
 
 fn warn_all(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
@@ -82,6 +126,7 @@ impl PyRenderer {
         Ok(PyRenderer {
             live: LiveRenderer::new(ctx, cache_dir, 2),
             last_pair: std::sync::Mutex::new(None),
+            headset_scene: std::sync::Mutex::new(None),
         })
     }
 
@@ -154,7 +199,9 @@ impl PyRenderer {
 
     /// A shipped scene (`scenes()`) or a scene .toml file as `eye` sees it; returns
     /// (H, W, 3) float32 linear RGB. Focus and pupil default to the scene's.
-    #[pyo3(signature = (scene, eye, *, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None, quality = "balanced"))]
+    /// `headset` ("quest3" or "vive-pro", instead of `size`) renders at a headset's panel and
+    /// vertical field (docs/binocular.md).
+    #[pyo3(signature = (scene, eye, *, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, method = "splat", layers = 1, off_axis = false, exposure_ev = None, quality = "balanced", headset = None))]
     #[allow(clippy::too_many_arguments)]
     fn render_scene<'py>(
         &self,
@@ -174,7 +221,9 @@ impl PyRenderer {
         off_axis: bool,
         exposure_ev: Option<f64>,
         quality: &str,
+        headset: Option<&str>,
     ) -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let headset = parse_headset(headset, size)?;
         let o = options(
             focus_m,
             focus_d,
@@ -190,9 +239,16 @@ impl PyRenderer {
         )
         .map_err(super::to_py)?;
         let eye = eye.eye.clone();
-        let (frame, warnings) = guarded(py, || {
-            self.live
-                .render_scene(SceneArg::Name(scene), &eye, &o, size, time_s)
+        let (frame, warnings) = guarded(py, || match headset {
+            Some(h) => {
+                let seen = self.headset_scene(scene, h)?;
+                let size = Some(h.spec().size());
+                self.live
+                    .render_scene(SceneArg::Loaded(&seen), &eye, &o, size, time_s)
+            }
+            None => self
+                .live
+                .render_scene(SceneArg::Name(scene), &eye, &o, size, time_s),
         })?;
         let (pixels, (w, h)) = (frame.color, (frame.report.width, frame.report.height));
         warn_all(py, &warnings)?;
@@ -204,7 +260,9 @@ impl PyRenderer {
     /// left eye for both) `ipd_mm` apart, converging on the focus point and sharing one
     /// accommodation and one pupil. Returns (left, right), each (H, W, 3) float32 linear RGB;
     /// `last_pair` says which eye drove accommodation and each eye's defocus.
-    #[pyo3(signature = (scene, left, right = None, *, ipd_mm = 63.0, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, exposure_ev = None, quality = "balanced"))]
+    /// `headset` ("quest3" or "vive-pro", instead of `size`) renders each eye at a headset's
+    /// panel and vertical field (docs/binocular.md).
+    #[pyo3(signature = (scene, left, right = None, *, ipd_mm = 63.0, size = None, time_s = 0.0, focus_m = None, focus_d = None, focus_at = None, pupil_mm = None, luminance_cdm2 = None, age = 30.0, exposure_ev = None, quality = "balanced", headset = None))]
     #[allow(clippy::too_many_arguments)]
     fn render_scene_pair<'py>(
         &self,
@@ -223,7 +281,9 @@ impl PyRenderer {
         age: f64,
         exposure_ev: Option<f64>,
         quality: &str,
+        headset: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let headset = parse_headset(headset, size)?;
         let o = options(
             focus_m,
             focus_d,
@@ -246,8 +306,17 @@ impl PyRenderer {
         let scene_name = scene.to_string();
         let pair = guarded(py, || {
             // the renderer's current scene: loaded once, its frames and geometry kept
-            let loaded = self.live.scene(SceneArg::Name(&scene_name))?;
-            let size = size.unwrap_or((loaded.resolution[0], loaded.resolution[1]));
+            let (loaded, size) = match headset {
+                Some(h) => {
+                    let seen = self.headset_scene(&scene_name, h)?;
+                    (self.live.scene(SceneArg::Loaded(&seen))?, h.spec().size())
+                }
+                None => {
+                    let loaded = self.live.scene(SceneArg::Name(&scene_name))?;
+                    let size = size.unwrap_or((loaded.resolution[0], loaded.resolution[1]));
+                    (loaded, size)
+                }
+            };
             crate::render::binocular::render_pair(
                 &self.live,
                 &crate::render::binocular::PairRequest {

@@ -157,8 +157,10 @@ impl Scene {
 
     /// The scene seen through a camera of another vertical field (a headset's): the field is
     /// fixed at `fov_y_deg` for the whole animation (a keyframed field is dropped), and
-    /// everything else is kept.
+    /// everything else is kept. It is a new scene to caches (its own id): frames kept for the
+    /// scene it came from are not its frames.
     pub fn with_fov_y_deg(mut self, fov_y_deg: f64) -> Scene {
+        self.id = next_scene_id();
         self.base_camera.fov_y_deg = fov_y_deg;
         self.timeline.fov_y_deg = Track::default();
         self

@@ -291,3 +291,22 @@ def test_a_binocular_pair_equals_the_cli_pair(tmp_path, cli, kernel_cache):
     assert not np.allclose(left, right)
     with pytest.raises(ValueError, match="--ipd-mm"):
         r.render_scene_pair("primitives", oc.Eye.preset("healthy"), ipd_mm=10.0)
+
+
+def test_a_headset_frame_equals_the_cli_headset_frame(tmp_path, cli, kernel_cache):
+    r = oc.Renderer(cache_dir=kernel_cache)
+    ours = r.render_scene("primitives", oc.Eye.preset("healthy"), headset="vive-pro",
+                          focus_m=0.5, pupil_mm=3.0, quality="fast")
+    assert ours.shape == (1600, 1440, 3)
+    out = tmp_path / "vr.exr"
+    subprocess.run(
+        [cli, "render", "--scene", "primitives", "--headset", "vive-pro", "--eye", "healthy",
+         "--focus-m", "0.5", "--pupil-mm", "3", "--quality", "fast", "--cache",
+         str(kernel_cache), "-o", str(out)],
+        check=True, capture_output=True)
+    theirs = oc.read_exr(out)[..., :3]
+    assert np.abs(ours - theirs).max() <= 1e-6 * float(np.abs(theirs).max())
+    with pytest.raises(ValueError, match="headset or size"):
+        r.render_scene("primitives", oc.Eye.preset("healthy"), headset="quest3", size=(64, 36))
+    with pytest.raises(ValueError, match="quest3, vive-pro"):
+        r.render_scene_pair("primitives", oc.Eye.preset("healthy"), headset="rift")

@@ -1,7 +1,7 @@
 """Type stubs of ocular_render (the extension module _ocular_render)."""
 
 from os import PathLike
-from typing import Literal, Optional, Sequence, Tuple, TypedDict, Union, overload
+from typing import Any, Dict, Literal, Optional, Sequence, Tuple, TypedDict, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -174,8 +174,35 @@ class Renderer:
         off_axis: bool = False,
         exposure_ev: Optional[float] = None,
         quality: Literal["exact", "balanced", "fast"] = "balanced",
+        headset: Optional[Literal["quest3", "vive-pro"]] = None,
     ) -> _F32:
-        """A shipped scene or scene .toml file as the eye sees it (size is (W, H))."""
+        """A shipped scene or scene .toml file as the eye sees it (size is (W, H); headset
+        instead of size: that headset's panel and vertical field)."""
+    def render_scene_pair(
+        self,
+        scene: str,
+        left: Eye,
+        right: Optional[Eye] = None,
+        *,
+        ipd_mm: float = 63.0,
+        size: Optional[Tuple[int, int]] = None,
+        time_s: float = 0.0,
+        focus_m: Optional[float] = None,
+        focus_d: Optional[float] = None,
+        focus_at: Optional[Tuple[int, int]] = None,
+        pupil_mm: Optional[float] = None,
+        luminance_cdm2: Optional[float] = None,
+        age: float = 30.0,
+        exposure_ev: Optional[float] = None,
+        quality: Literal["exact", "balanced", "fast"] = "balanced",
+        headset: Optional[Literal["quest3", "vive-pro"]] = None,
+    ) -> Tuple[_F32, _F32]:
+        """A scene through two eyes converging on the focus point and sharing one
+        accommodation and pupil, as `ocular render --binocular`: (left, right)."""
+    @property
+    def last_pair(self) -> Optional[Dict[str, Any]]:
+        """How the last pair was rendered: the driving eye, the shared accommodation, and
+        per eye (left, right) its focus, far point, demand and defocus at the target."""
     def rasterize(
         self, scene: str, *, size: Optional[Tuple[int, int]] = None, time_s: float = 0.0
     ) -> Tuple[_F32, _F32, float]:
