@@ -2,8 +2,9 @@
 //!
 //! File layout (little endian): magic `OCKGRID\0`, format version (u32), header length (u32),
 //! header (JSON: the key, axes, screen, radius, sizes), then per set its pupil and focus (f64),
-//! radii (3 f32 per object) and texels (3 f32 each), and last a 64-bit checksum of every byte
-//! before it. Files are written to a temporary name in the target folder and renamed, so a
+//! radii (3 f32 per object), top levels (u32 per object) and the blocks each object distance
+//! holds (level-major, then object; its top level and below, 3 f32 per texel; the blocks above
+//! are zero and not stored), and last a 64-bit checksum of every byte before it. Files are written to a temporary name in the target folder and renamed, so a
 //! reader never sees a partial file; a file that fails any check is reported, never loaded.
 
 use super::axes::{GridAxes, KernelSettings, Screen};
@@ -16,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"OCKGRID\0";
 /// Bump whenever the file layout or the numerics that produce the kernels change.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// A streaming 64-bit checksum: every 8-byte word goes through an invertible mix, so any
 /// change to one word changes the result.
@@ -127,6 +128,26 @@ struct Header {
     fov_y_deg: f64,
     height_px: u32,
     texels_per_set: u64,
+    /// Texels stored over all sets: the blocks each object distance holds (its top level
+    /// and below), the rest being zero.
+    stored_texels: u64,
+}
+
+/// The texel ranges of a set's held blocks, in file order: level-major, then object distance,
+/// each object's blocks up to its top level.
+fn held_ranges(set: &KernelSet) -> Vec<std::ops::Range<usize>> {
+    let levels = super::kernels::level_count(set.max_radius_px);
+    let mut out = Vec::new();
+    for level in 0..levels {
+        let n = super::kernels::kernel_side(super::kernels::level_block_radius(level)).pow(2);
+        for (o, &top) in set.top_level.iter().enumerate() {
+            if level <= top {
+                let start = set.block_offset(level, o);
+                out.push(start..start + n);
+            }
+        }
+    }
+    out
 }
 
 struct HashWriter<W: Write> {
@@ -182,6 +203,12 @@ fn write_to(tmp: &Path, grid: &KernelGrid, key: &str) -> Result<()> {
         fov_y_deg: grid.fov_y_deg,
         height_px: grid.height_px,
         texels_per_set: grid.sets[0].texels.len() as u64,
+        stored_texels: grid
+            .sets
+            .iter()
+            .flat_map(held_ranges)
+            .map(|r| r.len() as u64)
+            .sum(),
     };
     let text = serde_json::to_vec(&header).map_err(|e| Error::file(tmp, e))?;
     let io = |e: std::io::Error| Error::file(tmp, e);
@@ -193,7 +220,11 @@ fn write_to(tmp: &Path, grid: &KernelGrid, key: &str) -> Result<()> {
         w.put(&set.pupil_mm.to_le_bytes()).map_err(io)?;
         w.put(&set.focus_d.to_le_bytes()).map_err(io)?;
         w.put(bytemuck::cast_slice(&set.radius_px)).map_err(io)?;
-        w.put(bytemuck::cast_slice(&set.texels)).map_err(io)?;
+        w.put(bytemuck::cast_slice(&set.top_level)).map_err(io)?;
+        for range in held_ranges(set) {
+            w.put(bytemuck::cast_slice(&set.texels[range]))
+                .map_err(io)?;
+        }
     }
     let sum = w.sum.finish();
     let mut inner = w.inner;
@@ -264,13 +295,17 @@ pub fn read_grid(
     if texels != h.texels_per_set || sets == 0 || no == 0 {
         return Err("header sizes are inconsistent".into());
     }
-    let expected_len = 16 + hlen + sets as u64 * (16 + 12 * no as u64 + 12 * texels) + 8;
+    if h.stored_texels > sets as u64 * texels {
+        return Err("header sizes are inconsistent".into());
+    }
+    let expected_len = 16 + hlen + sets as u64 * (16 + 16 * no as u64) + 12 * h.stored_texels + 8;
     if len != expected_len {
         return Err(format!(
             "file is {len} bytes, its header implies {expected_len} (truncated or padded)"
         ));
     }
     let mut out = Vec::with_capacity(sets);
+    let mut stored = 0u64;
     for _ in 0..sets {
         let mut d = [0u8; 8];
         r.get(&mut d)?;
@@ -279,8 +314,22 @@ pub fn read_grid(
         let focus_d = f64::from_le_bytes(d);
         let mut set = KernelSet::zeroed(pupil_mm, focus_d, h.objects, h.max_radius_px);
         r.get(bytemuck::cast_slice_mut(&mut set.radius_px))?;
-        r.get(bytemuck::cast_slice_mut(&mut set.texels))?;
+        r.get(bytemuck::cast_slice_mut(&mut set.top_level))?;
+        let levels = super::kernels::level_count(h.max_radius_px);
+        if set.top_level.iter().any(|&t| t >= levels) {
+            return Err(format!("a top level is not below the {levels} levels"));
+        }
+        for range in held_ranges(&set) {
+            stored += range.len() as u64;
+            if stored > h.stored_texels {
+                return Err("the sets hold more texels than the header says".into());
+            }
+            r.get(bytemuck::cast_slice_mut(&mut set.texels[range]))?;
+        }
         out.push(set);
+    }
+    if stored != h.stored_texels {
+        return Err("the sets hold fewer texels than the header says".into());
     }
     let computed = r.sum.finish();
     let mut d = [0u8; 8];

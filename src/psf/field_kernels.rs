@@ -214,7 +214,8 @@ pub fn compute_kernel_field(
             screen,
             settings,
             &|_, _, _| {},
-            radius,
+            // every level: the four-node mix reads a node's kernels at its neighbours' radii
+            (radius, false),
         )?;
         report.seconds_optics = seconds_optics;
         progress(Stage::Kernels, i + 1, nodes.len());

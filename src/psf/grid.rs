@@ -14,6 +14,7 @@ use super::kernels::{
     kernel_side, level_block_radius, level_count, level_radius_px, texels_below_level, KernelGrid,
     KernelSet,
 };
+use super::level_band;
 use super::object_knots::{brackets, initial_knots, midpoint, open_intervals, weight};
 use super::project::{PsfMethod, MAX_BINS};
 use crate::eye::Eye;
@@ -159,7 +160,15 @@ pub fn kernels_from_columns(
 ) -> Result<(KernelGrid, GridReport)> {
     let psfs = psfs_of_columns(columns, axes, screen, settings, progress)?;
     let radius = psfs.natural_max_radius_px().ceil() as u32;
-    grid_from_psfs(columns, psfs, axes, screen, settings, progress, radius)
+    grid_from_psfs(
+        columns,
+        psfs,
+        axes,
+        screen,
+        settings,
+        progress,
+        (radius, true),
+    )
 }
 
 /// The PSFs of a grid's columns, kept as their pixel-integration bins: what the kernels are
@@ -311,7 +320,7 @@ pub(crate) fn grid_from_psfs(
     screen: &Screen,
     settings: &KernelSettings,
     progress: Progress,
-    radius_px: u32,
+    (radius_px, band): (u32, bool),
 ) -> Result<(KernelGrid, GridReport)> {
     let no = axes.objects.count;
     let seconds_psfs = summaries.seconds;
@@ -334,20 +343,31 @@ pub(crate) fn grid_from_psfs(
     let t2 = Instant::now();
     let done = AtomicUsize::new(0);
     let total_blocks = columns.len() * no;
-    let mut sets = Vec::with_capacity(columns.len());
-    for (s, col) in columns.iter().enumerate() {
-        let mut set = KernelSet::zeroed(col.pupil_mm, col.focus_d, axes.objects, max_radius);
-        // Per channel, the knots around every object sample (a knot is its own).
-        let around: [Vec<(usize, usize, f64)>; 3] =
-            std::array::from_fn(|c| brackets(no, |o| psf(s, c, o).is_some()));
+    let mut sets: Vec<KernelSet> = columns
+        .iter()
+        .map(|col| KernelSet::zeroed(col.pupil_mm, col.focus_d, axes.objects, max_radius))
+        .collect();
+    // Per set and channel, the knots around every object sample (a knot is its own), and the
+    // natural radii, the filled samples' blended like their kernels.
+    let arounds: Vec<Brackets> = (0..columns.len())
+        .map(|s| std::array::from_fn(|c| brackets(no, |o| psf(s, c, o).is_some())))
+        .collect();
+    for (s, (set, around)) in sets.iter_mut().zip(&arounds).enumerate() {
         for (c, around) in around.iter().enumerate() {
             let r = |k: usize| psf(s, c, k).map_or(0.0, |p| p.natural_radius_px);
             for (radii, &(a, b, t)) in set.radius_px.iter_mut().zip(around) {
                 radii[c] = ((1.0 - t) * r(a) + t * r(b)).min(max_radius as f64) as f32;
             }
         }
+    }
+    let tops = held_levels(&sets, &arounds, axes, band);
+    for (s, set) in sets.iter_mut().enumerate() {
+        let around = &arounds[s];
+        let (reads, held) = &tops[s];
+        set.top_level.clone_from(held);
         // Blocks are laid out level-major (level, then object). First the knots' blocks from
-        // their PSFs, in parallel over objects, each PSF's running sums shared by its levels.
+        // their PSFs, in parallel over objects, each PSF's running sums shared by its levels,
+        // up to the levels its filled neighbours read from it.
         let levels = level_count(max_radius);
         let mut per_object: Vec<Vec<LevelBlock>> = (0..no).map(|_| Vec::new()).collect();
         let mut rest: &mut [[f32; 3]] = &mut set.texels;
@@ -366,7 +386,7 @@ pub(crate) fn grid_from_psfs(
                 for c in 0..3 {
                     let Some(p) = psf(s, c, o) else { continue };
                     let sums = p.bins.summed_area();
-                    for (level, block) in blocks.iter_mut() {
+                    for (level, block) in blocks.iter_mut().take(reads[o] as usize + 1) {
                         let radius = level_block_radius(*level);
                         // the natural half-width spans r + ½ px: pixels of half_samples / (r + ½)
                         let scale = p.natural_half_samples / (level_radius_px(*level) + 0.5);
@@ -400,7 +420,7 @@ pub(crate) fn grid_from_psfs(
             let n = kernel_side(level_block_radius(*level)).pow(2);
             for (c, around) in around.iter().enumerate() {
                 for (o, &(a, b, t)) in around.iter().enumerate() {
-                    if a == o {
+                    if a == o || *level > held[o] {
                         continue;
                     }
                     let t = t as f32;
@@ -410,8 +430,13 @@ pub(crate) fn grid_from_psfs(
                     }
                 }
             }
+            // A knot's levels above what its distance holds served its neighbours' fill only.
+            for (o, block) in texels.chunks_exact_mut(n).enumerate() {
+                if *level > held[o] && *level <= reads[o] {
+                    block.fill([0.0; 3]);
+                }
+            }
         });
-        sets.push(set);
     }
     let seconds_kernels = t2.elapsed().as_secs_f64();
     let grid = KernelGrid {
@@ -474,6 +499,51 @@ pub(crate) fn grid_from_psfs(
     };
     Ok((grid, report))
 }
+
+/// Per set, the levels each object distance's knots are integrated to (what they and the
+/// samples filled from them read) and the levels it holds ([`super::level_band`]); every
+/// level everywhere without `band` (a field node's grid, whose kernels the four-node mix
+/// reads at its neighbours' radii).
+fn held_levels(
+    sets: &[KernelSet],
+    arounds: &[Brackets],
+    axes: &GridAxes,
+    band: bool,
+) -> Vec<(Vec<u32>, Vec<u32>)> {
+    let no = axes.objects.count;
+    if !band || sets.is_empty() {
+        let last = sets.first().map_or(0, |s| level_count(s.max_radius_px) - 1);
+        return sets
+            .iter()
+            .map(|_| (vec![last; no], vec![last; no]))
+            .collect();
+    }
+    // The widest gap between a set's knots: a filled sample lies that far from the knot
+    // whose levels it blends, so a knot is integrated over a window that much wider.
+    let window: Vec<usize> = arounds
+        .iter()
+        .map(|around| {
+            let gap = around
+                .iter()
+                .flatten()
+                .map(|&(a, b, _)| b - a)
+                .max()
+                .unwrap_or(0);
+            level_band::window_samples(axes.objects.step_d) + gap
+        })
+        .collect();
+    let radii: Vec<Vec<[f32; 3]>> = sets.iter().map(|s| s.radius_px.clone()).collect();
+    let shape = (axes.pupils_mm.len(), axes.focus_d.len());
+    let max_radius = sets[0].max_radius_px;
+    let own = vec![level_band::window_samples(axes.objects.step_d); sets.len()];
+    let knots = level_band::read_tops(&radii, shape, &window, max_radius);
+    let held = level_band::read_tops(&radii, shape, &own, max_radius);
+    knots.into_iter().zip(held).collect()
+}
+
+/// Per channel, the knots around every object sample and the weight of the upper one
+/// ([`brackets`]).
+type Brackets = [Vec<(usize, usize, f64)>; 3];
 
 /// One radius level's block of one object's kernel (texels RGB).
 type LevelBlock<'a> = (u32, &'a mut [[f32; 3]]);

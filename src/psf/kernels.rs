@@ -126,6 +126,10 @@ pub struct KernelSet {
     pub radius_px: Vec<[f32; 3]>,
     /// All kernel texels in texture order (see the module documentation).
     pub texels: Vec<[f32; 3]>,
+    /// Per object distance, the highest radius level its kernels hold: the blocks above are
+    /// zero, since no fragment reads them (the band of levels a frame can read at that
+    /// distance, [`super::grid`]); the last level where every level is held.
+    pub top_level: Vec<u32>,
 }
 
 impl KernelSet {
@@ -148,7 +152,17 @@ impl KernelSet {
             max_radius_px,
             radius_px: vec![[0.0; 3]; objects.count],
             texels: vec![[0.0; 3]; Self::texel_count(objects.count, max_radius_px)],
+            top_level: vec![level_count(max_radius_px) - 1; objects.count],
         }
+    }
+
+    /// Per object distance, the radius (px) of its highest held level: what the merge may
+    /// give a block at that distance at most (glsl/render/splat/merge.comp).
+    pub fn top_radius_px(&self) -> Vec<f32> {
+        self.top_level
+            .iter()
+            .map(|&l| level_radius_px(l) as f32)
+            .collect()
     }
 
     /// Index of the first texel of the block for radius `level` and object distance `object`.
@@ -189,7 +203,9 @@ impl KernelSet {
             .map(|o| {
                 [0, 1, 2].map(|c| {
                     let natural = f64::from(self.radius_px[o][c]);
-                    let level = (level_of_radius(natural).round() as u32).min(levels - 1);
+                    let level = (level_of_radius(natural).round() as u32)
+                        .min(levels - 1)
+                        .min(self.top_level[o]);
                     let values: Vec<f64> = self
                         .kernel(level, o)
                         .iter()
@@ -252,6 +268,13 @@ impl KernelSet {
         }
         if self.texels.iter().flatten().any(|v| !v.is_finite()) {
             return Err("kernel texels contain NaN or infinity".into());
+        }
+        let levels = level_count(self.max_radius_px);
+        if self.top_level.len() != self.objects.count || self.top_level.iter().any(|&l| l >= levels)
+        {
+            return Err(format!(
+                "one top radius level (below {levels}) per object distance is required"
+            ));
         }
         Ok(())
     }
@@ -362,6 +385,18 @@ impl KernelGrid {
         self.blend_objects(blend, |set| &self.sets[set].radius_px)
     }
 
+    /// Per object distance, the radius of the highest level the blend holds (every corner
+    /// holds it): the most a merged block's radius may be there.
+    pub fn blended_top_radius_px(&self, blend: &GridBlend) -> Vec<f32> {
+        let mut out = vec![f32::INFINITY; self.objects.count];
+        for &(index, _) in &blend.corners {
+            for (top, r) in out.iter_mut().zip(self.sets[index].top_radius_px()) {
+                *top = top.min(r);
+            }
+        }
+        out
+    }
+
     /// Per-set values (one triple per object distance) blended like the kernels.
     pub fn blend_per_object(&self, blend: &GridBlend, per_set: &[Vec<[f32; 3]>]) -> Vec<[f32; 3]> {
         self.blend_objects(blend, |set| &per_set[set])
@@ -389,6 +424,12 @@ impl KernelGrid {
         let blend = self.blend(pupil_mm, focus_d);
         let mut out = KernelSet::zeroed(pupil_mm, focus_d, self.objects, self.max_radius_px);
         out.radius_px = self.blended_radii(&blend);
+        // a level the blend holds only where every corner holds it
+        for &(index, _) in &blend.corners {
+            for (top, &t) in out.top_level.iter_mut().zip(&self.sets[index].top_level) {
+                *top = (*top).min(t);
+            }
+        }
         for &(index, w) in &blend.corners {
             for (dst, src) in out.texels.iter_mut().zip(&self.sets[index].texels) {
                 for c in 0..3 {

@@ -5,7 +5,8 @@
 //! - [`project`]: PSF sampling (ENZ or FFT per PSF), energy crop, screen orientation.
 //! - [`integrate`]: the PSF integrated over screen pixels of any size.
 //! - [`grid`]: the whole precomputation; [`plan`]: only what a scene needs;
-//!   [`object_knots`]: which object samples get a PSF of their own.
+//!   [`object_knots`]: which object samples get a PSF of their own; [`level_band`]: which
+//!   radius levels each object distance holds.
 //! - [`exact`]: exact kernels at any vergence for the ground truth.
 //! - [`field_shape`]: a field direction's elliptical pupil; [`field_psf`]: a channel's PSF
 //!   anywhere in the field (the on-axis one, or the disc's resampled onto the ellipse);
@@ -29,6 +30,7 @@ pub(crate) mod field_shape;
 pub(crate) mod grid;
 pub(crate) mod integrate;
 pub(crate) mod kernels;
+pub(crate) mod level_band;
 pub(crate) mod object_knots;
 pub(crate) mod plan;
 pub(crate) mod preview;

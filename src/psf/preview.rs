@@ -191,8 +191,10 @@ pub fn contact_sheet(grid: &KernelGrid) -> RgbImage {
         let mut kernels = Vec::new();
         for c in 0..3 {
             let r = (set.radius_px[o][c].ceil() as u32).min(grid.max_radius_px);
-            // A whole radius is always a level.
-            let k = set.kernel(level_of_radius(f64::from(r)) as u32, o);
+            // A whole radius is always a level; below 2 px its ceiling may lie above the
+            // levels the distance holds (src/psf/level_band.rs), and the highest held is drawn.
+            let level = (level_of_radius(f64::from(r)) as u32).min(set.top_level[o]);
+            let k = set.kernel(level, o);
             let peak = k.iter().map(|t| t[c]).fold(0.0f32, f32::max).max(1e-12);
             kernels.push((
                 r,

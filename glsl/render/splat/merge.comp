@@ -22,7 +22,8 @@ layout(push_constant) uniform MergePush {
 } push;
 
 // Per object distance o: natural radius per channel (xyz) and the smallest core radius (w) at
-// radii[o]; the smallest peak radius over the channels at radii[object_count + o].x.
+// radii[o]; the smallest peak radius over the channels at radii[object_count + o].x, and the
+// radius of the highest level the kernels hold there at .y (src/psf/level_band.rs).
 layout(std430, binding = 0) readonly buffer Radii { vec4 radii[]; };
 FRAGMENT_BUFFERS(1, 2, 3, 4, )
 FRAGMENT_LOAD
@@ -141,6 +142,13 @@ void main() {
     // the block (glsl/common/atlas.glsl, kernel_slot): exact too, the kernel's shape and any
     // centroid offset kept. The radius stays the children's, which picks the levels.
     m.radius = max(max(f[0].radius, f[1].radius), max(f[2].radius, f[3].radius));
+    // Within the levels the kernels hold at the block's distance: a block whose pixels span
+    // more dioptres than the band's window (a group tolerance far above the default) would
+    // otherwise read levels that are not there.
+    uint t0 = uint(floor(m.index));
+    uint t1 = min(t0 + 1u, frame.object_count - 1u);
+    uint n = frame.object_count;
+    m.radius = min(m.radius, vec3(min(radii[n + t0].y, radii[n + t1].y)));
     m.center = vec2(origin) + 0.5 * float(size);
     m.size = size;
     m.dioptre = 0.25 * (f[0].dioptre + f[1].dioptre + f[2].dioptre + f[3].dioptre);

@@ -471,11 +471,19 @@ impl Splatter {
         // Inputs and radii go through persistent mapped buffers: no allocation per frame.
         let input_bytes = source.stage(&ctx, self.frame.as_mut().expect("ensured above"))?;
         // After them, per object distance, the smallest peak radius over the channels (x),
-        // which bounds what averaging a block's colours can move (merge.comp).
+        // which bounds what averaging a block's colours can move, and the radius of the
+        // highest level the kernels hold there (y), which bounds a merged block's radius
+        // (merge.comp; off axis every node holds every level).
         let peak = self.grid.blend_per_object(&blend, &self.peak_radii);
+        let tops = if self.node_grids.is_empty() {
+            self.grid.blended_top_radius_px(&blend)
+        } else {
+            vec![f32::MAX; peak.len()]
+        };
         let peaks: Vec<[f32; 4]> = peak
             .iter()
-            .map(|p| [p[0].min(p[1]).min(p[2]), 0.0, 0.0, 0.0])
+            .zip(&tops)
+            .map(|(p, &top)| [p[0].min(p[1]).min(p[2]), top, 0.0, 0.0])
             .collect();
         self.radii_staging.write_mapped(0, &radii)?;
         self.radii_staging.write_mapped(radii.len(), &peaks)?;
