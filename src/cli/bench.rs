@@ -628,14 +628,15 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
 /// its vertical field for the scene's camera.
 fn headset_frame(args: &BenchArgs) -> Result<(BenchArgs, Scene)> {
     let scene = Scene::load(&args.scene)?;
-    Ok(match args.headset.map(|h| h.spec()) {
-        Some(h) => (
-            BenchArgs {
-                size: h.size(),
+    Ok(match args.headset {
+        Some(h) => {
+            let (scene, size) = h.spec().frame(scene);
+            let args = BenchArgs {
+                size,
                 ..args.clone()
-            },
-            scene.with_fov_y_deg(h.fov_y_deg),
-        ),
+            };
+            (args, scene)
+        }
         None => (args.clone(), scene),
     })
 }

@@ -324,7 +324,7 @@ fn check_file_options(args: &RenderArgs) -> Result<()> {
 pub fn scene_and_size(args: &RenderArgs, name: &str) -> Result<(Scene, (u32, u32))> {
     let scene = Scene::load(name)?;
     Ok(match args.headset.map(|h| h.spec()) {
-        Some(h) => (scene.with_fov_y_deg(h.fov_y_deg), h.size()),
+        Some(h) => h.frame(scene),
         None => {
             let size = args
                 .size

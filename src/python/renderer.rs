@@ -77,7 +77,7 @@ impl PyRenderer {
                 return Ok(Arc::clone(scene));
             }
         }
-        let scene = Arc::new(Scene::load(name)?.with_fov_y_deg(headset.spec().fov_y_deg));
+        let scene = Arc::new(headset.spec().frame(Scene::load(name)?).0);
         *kept = Some((name.to_string(), headset, Arc::clone(&scene)));
         Ok(scene)
     }

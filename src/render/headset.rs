@@ -9,6 +9,8 @@
 //! which is what a simulation of the wearer's eye needs, not a frame to send to the panel.
 //! docs/binocular.md lists the published figures each preset comes from.
 
+use crate::scene::Scene;
+
 /// A headset preset (`--headset`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -92,6 +94,12 @@ impl Headset {
 impl HeadsetSpec {
     pub fn size(&self) -> (u32, u32) {
         (self.width_px, self.height_px)
+    }
+
+    /// `scene` as one eye of this headset sees it, and the frame's size: its camera at the
+    /// headset's vertical field ([`Scene::with_fov_y_deg`]) and the panel's pixels.
+    pub fn frame(&self, scene: Scene) -> (Scene, (u32, u32)) {
+        (scene.with_fov_y_deg(self.fov_y_deg), self.size())
     }
 
     /// One eye's horizontal field (degrees): the pinhole's, from the panel's aspect.

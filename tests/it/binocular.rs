@@ -15,7 +15,13 @@ const FOV_Y_DEG: f64 = 20.0;
 /// black; its radius spans about 8 pixels at any distance.
 fn marker_scene(x_m: f64, d_m: f64) -> Scene {
     let focal = 0.5 * f64::from(SIZE.1) / (FOV_Y_DEG.to_radians() * 0.5).tan();
-    let radius = d_m * 8.0 / focal;
+    sphere_scene([x_m, 0.0, -d_m], d_m * 8.0 / focal, "")
+}
+
+/// One white sphere of `radius_m` at `centre_m` (view along −z), lit evenly, on near black,
+/// seen through a FOV_Y_DEG camera at SIZE; `extra` is appended to the scene's TOML.
+fn sphere_scene(centre_m: [f64; 3], radius_m: f64, extra: &str) -> Scene {
+    let [x, y, z] = centre_m;
     let text = format!(
         r#"
 name = "marker"
@@ -34,14 +40,13 @@ kind = "ambient"
 illuminance_lux = 300.0
 [[object]]
 kind = "sphere"
-radius_m = {radius}
+radius_m = {radius_m}
 segments = 256
-translate = [{x_m}, 0.0, {z}]
+translate = [{x}, {y}, {z}]
 color = [0.8, 0.8, 0.8]
-"#,
+{extra}"#,
         w = SIZE.0,
         h = SIZE.1,
-        z = -d_m
     );
     Scene::from_toml(&text, "marker scene", std::path::Path::new(".")).unwrap()
 }
@@ -1070,36 +1075,8 @@ fn a_headset_frame_has_its_panel_and_its_field() {
     let scene = |x_deg: f64, y_deg: f64| {
         let d = 3.0;
         let (x, y) = (d * x_deg.to_radians().tan(), d * y_deg.to_radians().tan());
-        let text = format!(
-            r#"
-name = "marker"
-[camera]
-position = [0.0, 0.0, 0.0]
-look_at = [0.0, 0.0, -1.0]
-fov_y_deg = 20.0
-near_m = 0.05
-far_m = 500.0
-[background]
-color = [1.0, 1.0, 1.0]
-luminance_cd_m2 = 0.01
-[[light]]
-kind = "ambient"
-illuminance_lux = 300.0
-[[object]]
-kind = "sphere"
-radius_m = 0.03
-segments = 256
-translate = [{x}, {y}, {z}]
-color = [0.8, 0.8, 0.8]
-[[keyframe]]
-time_s = 1.0
-camera = {{ fov_y_deg = 40.0 }}
-"#,
-            z = -d
-        );
-        Scene::from_toml(&text, "headset marker", std::path::Path::new("."))
-            .unwrap()
-            .with_fov_y_deg(spec.fov_y_deg)
+        let keyed = "[[keyframe]]\ntime_s = 1.0\ncamera = { fov_y_deg = 40.0 }\n";
+        sphere_scene([x, y, -d], 0.03, keyed).with_fov_y_deg(spec.fov_y_deg)
     };
     let ctx = gpu();
     let mut raster = Rasterizer::new(&ctx).unwrap();
