@@ -3,7 +3,7 @@
 
     tools/gpu_presets_table.py OUT_DIR
 
-Per scene, eye and size: each preset's GPU time split into the draw (raster, depth resolve, peel)
+Per scene, eye and size: each preset's GPU time split into the draw (raster, resolve, peel)
 and the splat (every other pass), its wall time per frame (upload and read-back included) and
 its texture reads per pixel; the old engine's total where it ran. Then the two-eye runs. Every
 number is read from the `ocular bench --json` reports; only sums, maxima and ratios are computed.

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The table of tools/gpu_vs_old.sh's runs: per scene, eye and size, the new engine's GPU time
-split into the draw (raster, depth resolve) and the splat passes (everything else), its wall
+split into the draw (raster, resolve) and the splat passes (everything else), its wall
 time, the old engine's, and their ratios; beside them the new engine with 2×2 merging only.
 
     tools/gpu_vs_old_table.py OUT_DIR
@@ -11,7 +11,8 @@ import json
 import os
 import sys
 
-DRAW = {"raster", "depth resolve", "peel"}
+# "depth resolve" is the resolve's name in reports before it resolved colour too
+DRAW = {"raster", "resolve", "depth resolve", "peel"}
 
 
 def load(folder, name):

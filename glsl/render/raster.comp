@@ -1,5 +1,8 @@
 #version 460
-// Resolves the multisampled targets without blending across edges. Depth: the nearest sample
+// Resolves the multisampled targets. Colour, on a GPU (push.colour): the mean of the samples,
+// what a render pass's resolve writes, but spread over every compute unit, where an H100 or
+// H200 runs a render pass's work on two TPCs (src/render/raster.rs). Depth, without blending
+// across edges: the nearest sample
 // wins, so an edge pixel takes the depth of the nearest surface in it (a mixed colour never
 // gets an in-between depth that belongs to no surface). Mixed pixels (issue 51, docs/
 // validation.md "Mixed pixels"): the samples within the blend's depth-group tolerance of the
@@ -18,6 +21,8 @@ layout(binding = 2) uniform sampler2DMS color_samples;
 layout(std430, binding = 3) writeonly buffer Rest { vec4 rest[]; };
 // The nearest depth among those samples (m); +∞ where there are none.
 layout(std430, binding = 4) writeonly buffer RestDepth { float rest_depth_m[]; };
+// The mean colour of the pixel's samples.
+layout(binding = 5, rgba32f) writeonly uniform image2D color_out;
 
 layout(push_constant) uniform Push {
     uint width;
@@ -28,6 +33,8 @@ layout(push_constant) uniform Push {
     // the blend's depth-group tolerance (D): samples this close to the nearest one in
     // vergence belong to its surface
     float group_tolerance_d;
+    // 1: write the colour's mean; 0: the render pass resolved it
+    uint colour;
 } push;
 
 const int MAX_SAMPLES = 8;
@@ -46,6 +53,14 @@ void main() {
         nearest = min(nearest, d[s]);
     }
     depth_m[i] = nearest;
+    if (push.colour != 0u) {
+        // summed in sample order and scaled by 1/n, as a render pass's average
+        vec4 sum = vec4(0.0);
+        for (int s = 0; s < n; ++s) {
+            sum += texelFetch(color_samples, ivec2(p), s);
+        }
+        imageStore(color_out, ivec2(p), sum * (1.0 / float(n)));
+    }
     if (push.split == 0u) {
         return;
     }

@@ -1,12 +1,14 @@
 //! The rasteriser: a scene at one instant → linear HDR colour and metric depth.
 //!
-//! One render pass draws the scene with 4× MSAA into a colour target (resolved by the render
-//! pass to a single-sample RGBA32F image) and a view-depth target (R32F, the distance along
-//! the view direction in metres, written per sample). A compute pass (raster.comp) then
-//! resolves depth with the nearest sample instead of an average, so depth never blends
-//! across an edge; asked to ([`Rasterizer::set_mixed_pixels`]), it also writes what lies behind
-//! the nearest surface in each pixel's samples (`Frame::rest`). Pixels no object covers get the
-//! background colour and depth `far_m`.
+//! One render pass draws the scene with 4× MSAA into a colour target (RGBA32F) and a view-depth
+//! target (R32F, the distance along the view direction in metres, written per sample). A
+//! compute pass (raster.comp) resolves depth to the nearest sample instead of an average, so
+//! depth never blends across an edge; asked to ([`Rasterizer::set_mixed_pixels`]), it also
+//! writes what lies behind the nearest surface in each pixel's samples (`Frame::rest`). Colour
+//! is resolved to the mean of its samples: on a GPU by that compute pass (an H200, which runs
+//! graphics on two of its TPCs, drew 4K 5–7 % faster so), on a CPU implementation by the render
+//! pass (lavapipe's compute resolve cost more than its render pass saved). Pixels no object
+//! covers get the background colour and depth `far_m`.
 //! Colour is 32-bit float throughout: values are cd/m², and lamps, the sun and specular
 //! emitters exceed half float's 65504 (a half-float target clipped them silently).
 //!
@@ -67,7 +69,7 @@ pub struct Frame {
     pub rest: Vec<[f32; 4]>,
     /// The nearest view depth among those samples (m); +∞ where there are none.
     pub rest_depth_m: Vec<f32>,
-    /// GPU time per pass ("raster", "depth resolve", "read back").
+    /// GPU time per pass ("raster", "resolve", "read back").
     pub timings: Timings,
 }
 
@@ -141,6 +143,8 @@ shader_block! {
         /// 1: also write the rest of mixed pixels (the visible layer); 0: depth only.
         split: u32,
         group_tolerance_d: f32,
+        /// 1: also write the colour's mean (a GPU's resolve); 0: the render pass resolved it.
+        colour: u32,
     }
 }
 
@@ -156,8 +160,10 @@ struct GpuScene {
 struct Targets {
     width: u32,
     height: u32,
-    /// Whether `color_ms` can be sampled (made so when mixed pixels are asked for).
-    color_sampled: bool,
+    /// Whether `rest` and `rest_depth` hold a frame (made so when mixed pixels are asked for).
+    mixed_pixels: bool,
+    /// Whether `color_ms` can be sampled (the compute resolve reads it).
+    colour_read: bool,
     color_ms: Image,
     depth_ms: Image,
     /// View depth per sample of layer 0 and every even layer.
@@ -213,6 +219,9 @@ pub struct Rasterizer {
     mixed_pixels: bool,
     /// Samples per pixel ([`MSAA_SAMPLES`] but for the draw's timing diagnostic).
     samples: u32,
+    /// Whether colour is resolved in compute (raster.comp) rather than by the render pass:
+    /// on GPUs (see the module's header).
+    colour_in_compute: bool,
 }
 
 impl Rasterizer {
@@ -231,14 +240,36 @@ impl Rasterizer {
     /// [`MSAA_SAMPLES`]: a timing diagnostic (`ocular bench --draw-samples`), since coverage
     /// and mixed pixels are only as fine as the samples.
     pub fn with_samples(ctx: &Context, inputs: SurfaceInputs, samples: u32) -> Result<Rasterizer> {
+        let on_gpu = ctx.device_info().kind != crate::gpu::DeviceKind::Cpu;
+        Self::build(ctx, inputs, samples, on_gpu)
+    }
+
+    /// A rasteriser that resolves colour in compute (`true`) or by the render pass, whatever
+    /// the device: the two give the same frames (`tests/it/raster.rs` holds them to it on
+    /// lavapipe, where [`Self::new`] resolves by the render pass).
+    pub fn with_colour_resolve(ctx: &Context, in_compute: bool) -> Result<Rasterizer> {
+        Self::build(ctx, SurfaceInputs::Covered, MSAA_SAMPLES, in_compute)
+    }
+
+    fn build(
+        ctx: &Context,
+        inputs: SurfaceInputs,
+        samples: u32,
+        colour_in_compute: bool,
+    ) -> Result<Rasterizer> {
         if !RASTER_SAMPLE_COUNTS.contains(&samples) {
             return Err(crate::Error::input(format!(
                 "raster samples per pixel: {samples}; allowed: 2, 4 or 8"
             )));
         }
-        let pipeline = Self::pipeline(ctx, false, inputs, samples)?;
-        let peel = Self::pipeline(ctx, true, SurfaceInputs::Covered, samples)?;
-        let resolve = ComputePipeline::builder("depth resolve", crate::shaders::RENDER_RASTER_COMP)
+        let pipeline = Self::pipeline(ctx, false, inputs, (samples, colour_in_compute))?;
+        let peel = Self::pipeline(
+            ctx,
+            true,
+            SurfaceInputs::Covered,
+            (samples, colour_in_compute),
+        )?;
+        let resolve = ComputePipeline::builder("resolve", crate::shaders::RENDER_RASTER_COMP)
             .push_constants::<ResolvePush>()
             .build(ctx)?;
         let white = Image::new_2d(
@@ -268,16 +299,18 @@ impl Rasterizer {
             view_magnification: [[1.0, 0.0], [0.0, 1.0]],
             mixed_pixels: false,
             samples,
+            colour_in_compute,
         })
     }
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
-    /// layer's samples, `previous_samples` in glsl/render/raster_peel.frag).
+    /// layer's samples, `previous_samples` in glsl/render/raster_peel.frag), with `samples`
+    /// per pixel and its colour resolved by the render pass unless `colour_in_compute`.
     fn pipeline(
         ctx: &Context,
         peel: bool,
         inputs: SurfaceInputs,
-        samples: u32,
+        (samples, colour_in_compute): (u32, bool),
     ) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
         let (name, fragment) = match (peel, inputs) {
@@ -321,7 +354,7 @@ impl Rasterizer {
                 )
                 .push_constants::<MaterialPush>()
                 .samples(samples)
-                .color_target(TexelFormat::Rgba32Float, true)
+                .color_target(TexelFormat::Rgba32Float, !colour_in_compute)
                 .color_target(TexelFormat::R32Float, false)
                 .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
                 .build(ctx)?,
@@ -369,7 +402,7 @@ impl Rasterizer {
 
     fn ensure_targets(&mut self, ctx: &Context, width: u32, height: u32) -> Result<()> {
         if self.targets.as_ref().is_some_and(|t| {
-            t.width == width && t.height == height && t.color_sampled == self.mixed_pixels
+            t.width == width && t.height == height && t.mixed_pixels == self.mixed_pixels
         }) {
             return Ok(());
         }
@@ -385,12 +418,13 @@ impl Rasterizer {
         let target = |name: &str, format: TexelFormat, usage: ImageUsage| {
             Image::new_2d(ctx, name, width, height, format, usage)
         };
-        // sampled only where the resolve reads the samples behind a silhouette apart
-        // (raster.comp): a sampled attachment may lose a GPU's colour compression
+        // sampled only where the compute resolve reads its samples (raster.comp): a sampled
+        // attachment may lose a GPU's colour compression
+        let colour_read = self.colour_in_compute || self.mixed_pixels;
         let color_ms = target(
             "raster colour (MSAA)",
             TexelFormat::Rgba32Float,
-            attachment(false, self.mixed_pixels, self.samples),
+            attachment(false, colour_read, self.samples),
         )?;
         let view_depth_ms = target(
             "raster view depth (MSAA)",
@@ -402,19 +436,26 @@ impl Rasterizer {
             TexelFormat::D32Float,
             attachment(true, false, self.samples),
         )?;
-        // storage: splat's input pass reads it where the frame stays on the GPU
+        // storage: the resolve writes it, and splat's input pass reads it where the frame
+        // stays on the GPU
         let color = target(
             "raster colour",
             TexelFormat::Rgba32Float,
             ImageUsage {
                 storage: true,
+                color_attachment: !self.colour_in_compute,
                 ..attachment(false, false, 1)
             },
         )?;
+        let resolves: &[&Image] = if self.colour_in_compute {
+            &[]
+        } else {
+            &[&color]
+        };
         let framebuffer = self.pipeline.framebuffer(
             ctx,
             &[&color_ms, &view_depth_ms],
-            &[&color],
+            resolves,
             Some(&depth_ms),
         )?;
         let pixels = u64::from(width) * u64::from(height);
@@ -438,7 +479,8 @@ impl Rasterizer {
             width,
             height,
             peel: None,
-            color_sampled: self.mixed_pixels,
+            mixed_pixels: self.mixed_pixels,
+            colour_read,
             color_ms,
             depth_ms,
             view_depth_ms,
@@ -468,11 +510,16 @@ impl Rasterizer {
                 samples: self.samples,
             },
         )?;
+        let resolves: &[&Image] = if self.colour_in_compute {
+            &[]
+        } else {
+            &[&targets.color]
+        };
         let framebuffer = |view_depth: &Image| {
             self.peel.framebuffer(
                 ctx,
                 &[&targets.color_ms, view_depth],
-                &[&targets.color],
+                resolves,
                 Some(&targets.depth_ms),
             )
         };
@@ -606,7 +653,7 @@ impl Rasterizer {
                 Buffer::new(ctx, name, pixels * bytes, Residency::Readback)
             };
             // the rest's read-backs hold a frame only where mixed pixels are asked for
-            let rest_pixels = if targets.color_sampled { 1 } else { 0 };
+            let rest_pixels = if targets.mixed_pixels { 1 } else { 0 };
             targets.readback = Some([
                 readback("raster colour read-back", 16)?,
                 readback("raster depth read-back", 4)?,
@@ -734,7 +781,7 @@ impl Rasterizer {
         Ok(())
     }
 
-    /// Records the prepared frame's draw and depth resolve: colour in `targets.color`, depth
+    /// Records the prepared frame's draw and resolve: colour in `targets.color`, depth
     /// in `targets.depth`.
     fn record(
         &self,
@@ -811,19 +858,19 @@ impl Rasterizer {
             )?;
         }
         rec.end_render_pass()?;
-        rec.begin_pass("depth resolve");
+        rec.begin_pass("resolve");
         rec.compute(&self.resolve)
             .read(
                 "view_depth",
                 (targets.view_depth(layer), &self.point_sampler),
             )
             .write("Depth", &targets.depth)
-            // without the split the shader reads no colour sample: any multisampled image
-            // that can be sampled stands in
+            // where the shader reads no colour sample, any multisampled image that can be
+            // sampled stands in
             .read(
                 "color_samples",
                 (
-                    if targets.color_sampled {
+                    if targets.colour_read {
                         &targets.color_ms
                     } else {
                         targets.view_depth(layer)
@@ -831,6 +878,7 @@ impl Rasterizer {
                     &self.point_sampler,
                 ),
             )
+            .write("color_out", &targets.color)
             .write("Rest", &targets.rest)
             .write("RestDepth", &targets.rest_depth)
             .push(&ResolvePush {
@@ -839,6 +887,7 @@ impl Rasterizer {
                 samples: self.samples,
                 split: u32::from(layer == 0 && self.mixed_pixels),
                 group_tolerance_d: crate::render::blend::DEFAULT_GROUP_TOLERANCE_D,
+                colour: u32::from(self.colour_in_compute),
             })
             .dispatch([width.div_ceil(8), height.div_ceil(8), 1])?;
         // The MSAA depth buffer lives as long as the framebuffers that use it.

@@ -306,7 +306,7 @@ fn bench_reports_every_pass_and_totals_that_add_up() {
     );
     for want in [
         "raster",
-        "depth resolve",
+        "resolve",
         "input",
         "fragments",
         "tile count",
