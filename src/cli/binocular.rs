@@ -448,6 +448,37 @@ fn output_paths(args: &RenderArgs, stereo: StereoOutput) -> Vec<PathBuf> {
     }
 }
 
+/// The pair's images as `stereo` lays them out: the two frames (left, right) for
+/// `separate`, else one.
+pub fn stereo_images(
+    stereo: StereoOutput,
+    (w, h): (u32, u32),
+    frames: &[&Vec<[f32; 4]>; 2],
+) -> Vec<ImageRgba> {
+    match stereo {
+        StereoOutput::Separate => (0..2)
+            .map(|e| ImageRgba::new(w, h, frames[e].clone()))
+            .collect(),
+        StereoOutput::SideBySide => {
+            let mut pixels = Vec::with_capacity(2 * frames[0].len());
+            for row in 0..h as usize {
+                for f in frames.iter() {
+                    pixels.extend_from_slice(&f[row * w as usize..(row + 1) * w as usize]);
+                }
+            }
+            vec![ImageRgba::new(2 * w, h, pixels)]
+        }
+        StereoOutput::Anaglyph => {
+            let pixels = frames[0]
+                .iter()
+                .zip(frames[1].iter())
+                .map(|(l, r)| [l[0], r[1], r[2], 1.0])
+                .collect();
+            vec![ImageRgba::new(w, h, pixels)]
+        }
+    }
+}
+
 /// Writes the pair as asked into the temporaries of `files` (`paths` in order).
 fn write(
     args: &RenderArgs,
@@ -470,28 +501,7 @@ fn write(
             image_io::write_png(path, image, Tonemap { exposure_ev, mode })
         }
     };
-    let images: Vec<ImageRgba> = match stereo {
-        StereoOutput::Separate => (0..2)
-            .map(|e| ImageRgba::new(w, h, frames[e].clone()))
-            .collect(),
-        StereoOutput::SideBySide => {
-            let mut pixels = Vec::with_capacity(2 * frames[0].len());
-            for row in 0..h as usize {
-                for f in frames.iter() {
-                    pixels.extend_from_slice(&f[row * w as usize..(row + 1) * w as usize]);
-                }
-            }
-            vec![ImageRgba::new(2 * w, h, pixels)]
-        }
-        StereoOutput::Anaglyph => {
-            let pixels = frames[0]
-                .iter()
-                .zip(frames[1].iter())
-                .map(|(l, r)| [l[0], r[1], r[2], 1.0])
-                .collect();
-            vec![ImageRgba::new(w, h, pixels)]
-        }
-    };
+    let images = stereo_images(stereo, (w, h), frames);
     for (path, image) in paths.iter().zip(&images) {
         save(path, image)?;
     }

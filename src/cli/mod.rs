@@ -30,6 +30,7 @@ mod video;
 mod video_files;
 mod video_frame;
 mod video_manifest;
+mod video_pair;
 
 #[derive(Debug, Parser)]
 #[command(

@@ -19,6 +19,7 @@ use super::video_files::{
 };
 use super::video_frame::{self, compose};
 use super::video_manifest::{self as manifest, DigestLog, ExportConfig};
+use super::video_pair;
 use super::{sha256, Cli};
 use crate::eye::Eye;
 use crate::gpu::Context;
@@ -40,7 +41,8 @@ pub enum FrameFormat {
 #[command(after_help = "Examples:\n  \
     ocular video --scene walk --eye myopia -o frames/ --mp4 walk.mp4\n  \
     ocular video --scene walk --eye healthy --side-by-side keratoconus -o cmp/\n  \
-    ocular video --scene primitives --eye healthy --focus-sweep 0.2..7.5 --duration 4 -o sweep/\n\n\
+    ocular video --scene primitives --eye healthy --focus-sweep 0.2..7.5 --duration 4 -o sweep/\n  \
+    ocular video --scene walk --binocular --eye healthy --eye-right near.toml --age 55 -o pair/\n\n\
 Split a long export across machines with --frames A..B (frames A to B−1): each job writes its own \
 files into the same folder, and the union is identical to one run. The folder's ocular-video.json \
 records the configuration: a run with another one is refused unless --overwrite. A frame is \
@@ -71,10 +73,38 @@ pub struct VideoArgs {
     /// Frame size (default: the scene's `resolution`).
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size)]
     pub size: Option<(u32, u32)>,
+    /// Render each frame (each eye's, with --binocular) at a headset's panel size and vertical
+    /// field, the scene's camera taking that field throughout: quest3 (2064×2208, 96°),
+    /// vive-pro (1440×1600, 110°). docs/binocular.md gives the published figures.
+    #[arg(long, value_enum, conflicts_with = "size")]
+    pub headset: Option<crate::render::headset::Headset>,
     /// Render every frame through this second eye as well, side by side and labelled;
     /// `uncorrected` is the --eye without --correct/--iol-d.
     #[arg(long, value_name = "NAME|FILE|uncorrected")]
     pub side_by_side: Option<String>,
+    /// Render through two eyes (--eye for both, or the left with --eye-right): the scene's
+    /// camera is the point between them, both converge on each frame's focus straight ahead
+    /// and share one accommodation and pupil, as `render --binocular` (docs/binocular.md).
+    #[arg(long)]
+    pub binocular: bool,
+    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub eye_right: Option<String>,
+    /// The right eye's own spectacle or contact lens, "S C x A" (as --correct, whose
+    /// --vertex-mm and --correct-contact it shares); --correct is then the left eye's.
+    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
+    pub correct_right: Option<crate::eye::correction::Spectacle>,
+    /// The right eye's own intraocular lens: a power in dioptres (-10 to 40), `auto` or `none`
+    /// (the right eye keeps its crystalline lens); --iol-d is then the left eye's.
+    #[arg(long, value_name = "D|auto|none", value_parser = super::binocular::parse_right_iol, allow_hyphen_values = true)]
+    pub iol_d_right: Option<super::binocular::RightIol>,
+    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub ipd_mm: Option<f64>,
+    /// How a binocular pair is written (default side-by-side: one frame twice as wide, the left
+    /// eye on the left; separate: frame_NNNNNN-left and -right files; anaglyph: red-cyan).
+    #[arg(long, value_enum)]
+    pub stereo: Option<super::binocular::StereoOutput>,
     #[command(flatten)]
     pub correction: super::correction::CorrectionArgs,
     /// Observer age (years), 20 to 83: the Watson–Yellott pupil and Hofstetter's mean
@@ -227,45 +257,32 @@ fn eye_sha256(eye: &Eye) -> Result<String> {
 /// `--mp4` is checked before any frame is rendered: ffmpeg, the extension, the folder.
 pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     check_args(args)?;
-    let sweep = args
-        .focus_sweep
-        .as_deref()
-        .map(parse_sweep)
-        .transpose()
-        .map_err(Error::input)?;
-    let scene = Scene::load(&args.scene)?;
-    let duration = args.duration.unwrap_or(if sweep.is_some() {
-        2.0
-    } else {
-        scene.duration_s()
-    });
-    if !(duration.is_finite() && duration >= 0.0) {
-        return Err(Error::input(format!(
-            "--duration {duration} must be a non-negative number of seconds"
-        )));
-    }
-    let count = ((duration * args.fps).round() as usize).max(1);
+    let (timeline, headset_size) = timeline_of(args)?;
+    let count = timeline.count;
     let (first, end) = match &args.frames {
         Some(text) => parse_range(text, count).map_err(Error::input)?,
         None => (0, count),
     };
     // The pupil model's age also sets the amplitude of accommodation, as in render.
-    let eyes = args.correction.labelled_eyes(
-        &args.eye,
-        load_eye("--eye", &args.eye)?,
-        args.side_by_side.as_deref(),
-        |spec| load_eye("--side-by-side", spec),
-        Some((args.age, crate::eye::age::HofstetterLine::Mean)),
-    )?;
-    prepare_folder(&args.output)?;
-    let timeline = Timeline {
-        scene,
-        fps: args.fps,
-        count,
-        sweep,
+    let pair = video_pair::asked(args)
+        .then(|| video_pair::PairSetup::from_args(args))
+        .transpose()?;
+    let eyes = match &pair {
+        Some(p) => (0..2)
+            .map(|e| (p.specs[e].clone(), p.eyes[e].0.clone()))
+            .collect(),
+        None => args.correction.labelled_eyes(
+            &args.eye,
+            load_eye("--eye", &args.eye)?,
+            args.side_by_side.as_deref(),
+            |spec| load_eye("--side-by-side", spec),
+            Some((args.age, crate::eye::age::HofstetterLine::Mean)),
+        )?,
     };
+    prepare_folder(&args.output)?;
     let (width, height) = args
         .size
+        .or(headset_size)
         .unwrap_or((timeline.scene.resolution[0], timeline.scene.resolution[1]));
     let mut options = args.cache.kernel_options();
     options.field_width_px = args.off_axis.then_some(width);
@@ -293,8 +310,23 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     let mut log = DigestLog::create(&args.output)?;
     let mut rasterizer = Rasterizer::new(&ctx)?;
     let mut renderers = Vec::new();
+    let mut pair_export = None;
     let mut exposure_ev = args.exposure;
-    if !todo.is_empty() {
+    if let (false, Some(setup)) = (todo.is_empty(), pair) {
+        let (needs, auto_ev) = video_pair::plan(
+            &ctx,
+            &mut rasterizer,
+            &setup,
+            &timeline,
+            (width, height),
+            args,
+        )?;
+        exposure_ev = exposure_ev.or(auto_ev);
+        let splat = splat_settings(args, exposure_ev);
+        pair_export = Some(video_pair::PairExport::new(
+            &ctx, setup, needs, options, splat,
+        )?);
+    } else if !todo.is_empty() {
         let (needs, auto_ev) = animation_needs(
             &ctx,
             &mut rasterizer,
@@ -304,13 +336,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
             args.exposure.is_none(),
         )?;
         exposure_ev = exposure_ev.or(auto_ev);
-        // The merge's colour bound is a fraction of the white the frames are shown at: frame
-        // 0's automatic exposure unless --exposure fixes it (EXR frames too, where it is how
-        // they would be viewed).
-        let mut splat = args.quality.settings();
-        if let Some(ev) = exposure_ev {
-            splat.merge.white = crate::render::splat::display_white(ev);
-        }
+        let splat = splat_settings(args, exposure_ev);
         for (_, eye) in &eyes {
             let kernels = super::prepare_kernels(eye, &needs, &options)?;
             renderers.push(FrameRenderer::new(
@@ -329,6 +355,7 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         size: (width, height),
         eyes: &eyes,
         renderers: &mut renderers,
+        pair: pair_export.as_mut(),
         exposure_ev: exposure_ev.unwrap_or(0.0),
     };
     let started = Instant::now();
@@ -346,8 +373,59 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
     Ok(())
 }
 
+/// The scene's animation (or the sweep) as frames, and the headset's panel if one is asked (the
+/// scene then seen through its field).
+fn timeline_of(args: &VideoArgs) -> Result<(Timeline, Option<(u32, u32)>)> {
+    let sweep = args
+        .focus_sweep
+        .as_deref()
+        .map(parse_sweep)
+        .transpose()
+        .map_err(Error::input)?;
+    let (scene, headset_size) = match args.headset.map(|h| h.spec()) {
+        Some(h) => {
+            let (scene, size) = h.frame(Scene::load(&args.scene)?);
+            (scene, Some(size))
+        }
+        None => (Scene::load(&args.scene)?, None),
+    };
+    let duration = args.duration.unwrap_or(if sweep.is_some() {
+        2.0
+    } else {
+        scene.duration_s()
+    });
+    if !(duration.is_finite() && duration >= 0.0) {
+        return Err(Error::input(format!(
+            "--duration {duration} must be a non-negative number of seconds"
+        )));
+    }
+    let count = ((duration * args.fps).round() as usize).max(1);
+    let timeline = Timeline {
+        scene,
+        fps: args.fps,
+        count,
+        sweep,
+    };
+    Ok((timeline, headset_size))
+}
+
+/// The splatter's settings: the preset's, with the merge's colour bound a fraction of the white
+/// the frames are shown at: frame 0's automatic exposure unless --exposure fixes it (EXR frames
+/// too, where it is how they would be viewed).
+fn splat_settings(
+    args: &VideoArgs,
+    exposure_ev: Option<f32>,
+) -> crate::render::splat::SplatSettings {
+    let mut splat = args.quality.settings();
+    if let Some(ev) = exposure_ev {
+        splat.merge.white = crate::render::splat::display_white(ev);
+    }
+    splat
+}
+
 /// The options checked on their own, before the scene is read.
 fn check_args(args: &VideoArgs) -> Result<()> {
+    video_pair::check(args)?;
     if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
         return Err(Error::input(format!(
             "--fps {} must lie in (0, 1000]",
@@ -418,7 +496,10 @@ fn export_config(
         eye: args.eye.clone(),
         eye_sha256: eye_sha256(&eyes[0].1)?,
         side_by_side: args.side_by_side.clone(),
-        side_by_side_sha256: eyes.get(1).map(|(_, e)| eye_sha256(e)).transpose()?,
+        side_by_side_sha256: match &args.side_by_side {
+            Some(_) => eyes.get(1).map(|(_, e)| eye_sha256(e)).transpose()?,
+            None => None,
+        },
         size: [width, height],
         fps: args.fps,
         frame_count: timeline.count,
@@ -430,6 +511,18 @@ fn export_config(
         pupil_mm: args.pupil_mm,
         exposure_ev: args.exposure,
         layers: args.layers.filter(|&k| k > 1),
+        binocular: if video_pair::asked(args) {
+            Some(manifest::PairConfig {
+                eye_right: args.eye_right.clone().unwrap_or_else(|| args.eye.clone()),
+                eye_right_sha256: eye_sha256(&eyes[1].1)?,
+                ipd_mm: args
+                    .ipd_mm
+                    .unwrap_or(crate::render::binocular::DEFAULT_IPD_MM),
+                stereo: video_pair::stereo_name(args).to_string(),
+            })
+        } else {
+            None
+        },
         settings_sha256: sha256_of_debug(&parts),
     })
 }
@@ -441,12 +534,20 @@ fn frames_to_render(args: &VideoArgs, range: std::ops::Range<usize>) -> Vec<usiz
     let mut todo = Vec::new();
     let mut rejected = 0usize;
     for i in range {
-        let name = frame_name(i, args.format);
-        let path = args.output.join(&name);
-        if path.exists() {
-            if manifest::verified(&path, digests.get(&name)) {
-                continue;
-            }
+        let names = video_pair::frame_names(args, i);
+        let present: Vec<std::path::PathBuf> = names
+            .iter()
+            .map(|name| args.output.join(name))
+            .filter(|path| path.exists())
+            .collect();
+        let intact = names.iter().all(|name| {
+            let path = args.output.join(name);
+            path.exists() && manifest::verified(&path, digests.get(name))
+        });
+        if intact {
+            continue;
+        }
+        if !present.is_empty() {
             rejected += 1;
         }
         todo.push(i);
@@ -469,6 +570,8 @@ struct Export<'a> {
     size: (u32, u32),
     eyes: &'a [(String, Eye)],
     renderers: &'a mut [FrameRenderer],
+    /// Two eyes (`--binocular`): the pair's renderers in place of `renderers`.
+    pair: Option<&'a mut video_pair::PairExport>,
     exposure_ev: f32,
 }
 
@@ -486,39 +589,69 @@ impl Export<'_> {
         let labels: Vec<&str> = self.eyes.iter().map(|(name, _)| name.as_str()).collect();
         let bar = super::frame_progress_bar(todo.len() as u64);
         for &i in todo {
-            let state = self.timeline.state(i);
-            let panels = video_frame::render_panels(
-                self.ctx,
-                self.rasterizer,
-                &state,
-                self.size,
-                (args, self.timeline.focus_d(i, &state), fov_y_deg),
-                self.renderers,
-                &magnifications,
-            )?;
-            let shown = (panels.len() > 1).then_some(&labels[..]);
-            let image = compose(width, height, &panels, shown);
-            let name = frame_name(i, args.format);
-            let path = args.output.join(&name);
-            let bytes = match args.format {
-                FrameFormat::Png => image_io::png_bytes(
-                    &image,
-                    Tonemap {
-                        exposure_ev: self.exposure_ev,
-                        mode: TonemapMode::Clamp,
-                    },
-                ),
-                FrameFormat::Exr => image_io::exr_rgba_bytes(&image),
+            let images = match self.pair.as_deref_mut() {
+                Some(pair) => {
+                    let [left, right] = pair.render(
+                        self.ctx,
+                        self.rasterizer,
+                        self.timeline,
+                        (i, self.size),
+                        args,
+                    )?;
+                    super::binocular::stereo_images(
+                        video_pair::stereo(args),
+                        self.size,
+                        &[&left, &right],
+                    )
+                }
+                None => {
+                    let state = self.timeline.state(i);
+                    let panels = video_frame::render_panels(
+                        self.ctx,
+                        self.rasterizer,
+                        &state,
+                        self.size,
+                        (args, self.timeline.focus_d(i, &state), fov_y_deg),
+                        self.renderers,
+                        &magnifications,
+                    )?;
+                    let shown = (panels.len() > 1).then_some(&labels[..]);
+                    vec![compose(width, height, &panels, shown)]
+                }
+            };
+            for (name, image) in video_pair::frame_names(args, i).iter().zip(&images) {
+                self.write(args, name, image, log)?;
             }
-            .map_err(|m| Error::file(&path, m))?;
-            // The digest is durable before the frame has its final name, so every frame a
-            // later run finds under a final name can be verified.
-            log.record(&name, &bytes)?;
-            write_frame(&args.output, &name, &bytes)?;
             bar.inc(1);
         }
         bar.finish_and_clear();
         Ok(())
+    }
+
+    /// Encodes one frame file and writes it under `name`, its digest recorded first.
+    fn write(
+        &self,
+        args: &VideoArgs,
+        name: &str,
+        image: &image_io::ImageRgba,
+        log: &mut DigestLog,
+    ) -> Result<()> {
+        let path = args.output.join(name);
+        let bytes = match args.format {
+            FrameFormat::Png => image_io::png_bytes(
+                image,
+                Tonemap {
+                    exposure_ev: self.exposure_ev,
+                    mode: TonemapMode::Clamp,
+                },
+            ),
+            FrameFormat::Exr => image_io::exr_rgba_bytes(image),
+        }
+        .map_err(|m| Error::file(&path, m))?;
+        // The digest is durable before the frame has its final name, so every frame a later
+        // run finds under a final name can be verified.
+        log.record(name, &bytes)?;
+        write_frame(&args.output, name, &bytes)
     }
 }
 

@@ -26,7 +26,7 @@ pub(super) fn pupil_asked(args: &VideoArgs) -> PupilAsked<'static> {
 }
 
 /// Whether the pupil follows the frame's own mean luminance.
-fn pupil_needs_frame(args: &VideoArgs, state: &FrameState<'_>) -> bool {
+pub(super) fn pupil_needs_frame(args: &VideoArgs, state: &FrameState<'_>) -> bool {
     frame_plan::pupil_needs_frame(&pupil_asked(args), &SceneEye::of(state))
 }
 

@@ -43,8 +43,22 @@ pub struct ExportConfig {
     /// Depth layers above one (absent for one, so one-layer manifests read as before).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub layers: Option<u32>,
+    /// Two eyes (`--binocular`; absent for one, so one-eye manifests read as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub binocular: Option<PairConfig>,
     /// SHA-256 of the kernel and splatting settings.
     pub settings_sha256: String,
+}
+
+/// What a binocular export adds: the right eye (`eye` is then the left one), both as corrected,
+/// the interpupillary distance and how the pair is laid out.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairConfig {
+    pub eye_right: String,
+    pub eye_right_sha256: String,
+    pub ipd_mm: f64,
+    pub stereo: String,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -156,6 +170,15 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
         old.layers != new.layers,
         there_here("--layers", old.layers.unwrap_or(1), new.layers.unwrap_or(1)),
     );
+    let eyes = |p: &Option<PairConfig>| if p.is_some() { "two eyes" } else { "one eye" };
+    let pair = match (&old.binocular, &new.binocular) {
+        (Some(a), Some(b)) => pair_differences(a, b),
+        (a, b) if a.is_some() != b.is_some() => vec![there_here("--binocular", eyes(a), eyes(b))],
+        _ => Vec::new(),
+    };
+    for line in pair {
+        field(true, line);
+    }
     field(
         old.settings_sha256 != new.settings_sha256,
         "renderer settings differ".to_string(),
@@ -163,7 +186,31 @@ pub fn differences(old: &ExportConfig, new: &ExportConfig) -> Vec<String> {
     out
 }
 
-/// Whether a name is one of the export's frame files (`frame_NNNNNN.png|exr`).
+/// One line per field of two pairs' configurations that differs.
+fn pair_differences(old: &PairConfig, new: &PairConfig) -> Vec<String> {
+    let mut out = Vec::new();
+    if old.eye_right_sha256 != new.eye_right_sha256 {
+        out.push(if old.eye_right == new.eye_right {
+            format!(
+                "--eye-right {}: the right eye's content or its --correct-right / --iol-d-right \
+                 changed",
+                new.eye_right
+            )
+        } else {
+            there_here("--eye-right", &old.eye_right, &new.eye_right)
+        });
+    }
+    if old.ipd_mm != new.ipd_mm {
+        out.push(there_here("--ipd-mm", old.ipd_mm, new.ipd_mm));
+    }
+    if old.stereo != new.stereo {
+        out.push(there_here("--stereo", &old.stereo, &new.stereo));
+    }
+    out
+}
+
+/// Whether a name is one of the export's frame files (`frame_NNNNNN.png|exr`, or a pair's
+/// `frame_NNNNNN-left.png` and `-right`).
 pub fn is_frame_name(name: &str) -> bool {
     let Some(rest) = name.strip_prefix("frame_") else {
         return false;
@@ -171,6 +218,10 @@ pub fn is_frame_name(name: &str) -> bool {
     let Some((digits, ext)) = rest.split_once('.') else {
         return false;
     };
+    let digits = digits
+        .strip_suffix("-left")
+        .or_else(|| digits.strip_suffix("-right"))
+        .unwrap_or(digits);
     digits.len() >= 6
         && digits.bytes().all(|b| b.is_ascii_digit())
         && (ext == "png" || ext == "exr")

@@ -341,24 +341,63 @@ impl Yoked<'_> {
     }
 }
 
-/// `o` focused where the yoke puts the eye: at `focus_d` where that is a real point (the eye
-/// accommodates to it), else (a hyperopic eye that exerts less than it would need for infinity,
-/// its focus beyond infinity) at infinity with the amplitude limited to what it exerts,
-/// `focus_d − far_point_d`, so that the eye stops at exactly that accommodation.
-fn at_accommodation(o: &LiveOptions, far_point_d: f64, focus_d: f64) -> LiveOptions {
+/// What an eye is rendered at to focus where the yoke puts it: (the focus asked of it, an
+/// amplitude of accommodation that replaces its own). At `focus_d` itself where that is a real
+/// point (the eye accommodates to it); else (a hyperopic eye that exerts less than it would
+/// need for infinity, its focus beyond infinity) at infinity with the amplitude limited to
+/// what it exerts, `focus_d − far_point_d`, so that the eye stops at exactly that
+/// accommodation.
+pub fn yoked_focus(far_point_d: f64, focus_d: f64) -> (f64, Option<f64>) {
     if focus_d >= 0.0 {
-        return LiveOptions {
-            focus: Some(FocusAsked::Dioptres(focus_d)),
-            ..o.clone()
-        };
+        (focus_d, None)
+    } else {
+        (0.0, Some((focus_d - far_point_d).max(0.0)))
     }
+}
+
+/// `o` focused where the yoke puts the eye ([`yoked_focus`]).
+fn at_accommodation(o: &LiveOptions, far_point_d: f64, focus_d: f64) -> LiveOptions {
+    let (focus_d, amplitude_d) = yoked_focus(far_point_d, focus_d);
     LiveOptions {
-        focus: Some(FocusAsked::Dioptres(0.0)),
+        focus: Some(FocusAsked::Dioptres(focus_d)),
         correction: Correction {
-            accommodation_max_d: Some((focus_d - far_point_d).max(0.0)),
+            accommodation_max_d: amplitude_d.or(o.correction.accommodation_max_d),
             ..o.correction.clone()
         },
         ..o.clone()
+    }
+}
+
+/// Two eyes at one instant of an animation, fixating the point `focus_d` straight ahead of the
+/// camera (0: infinity, the eyes parallel).
+#[derive(Clone, Copy, Debug)]
+pub struct PairInstant {
+    /// Left, right: where each eye sits and looks.
+    pub cameras: [Camera; 2],
+    pub demand_d: [f64; 2],
+    pub yoke: Yoke,
+}
+
+/// The pair at one instant, given each eye's far point (D, signed) and amplitude at that
+/// instant's pupil: what `ocular video --binocular` renders each frame from, the geometry and
+/// the accommodation of [`render_pair`] for a focus straight ahead.
+pub fn pair_instant(
+    camera: &Camera,
+    ipd_m: f64,
+    focus_d: f64,
+    far_point_d: [f64; 2],
+    amplitude_d: [Option<f64>; 2],
+) -> PairInstant {
+    let fixation = if focus_d > 0.0 {
+        point_ahead(camera, 1.0 / focus_d)
+    } else {
+        None
+    };
+    let demand_d = demands_d(&eye_positions(camera, ipd_m), fixation);
+    PairInstant {
+        cameras: eye_cameras(camera, ipd_m, fixation),
+        demand_d,
+        yoke: yoke(demand_d, far_point_d, amplitude_d),
     }
 }
 
