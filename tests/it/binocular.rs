@@ -1385,3 +1385,62 @@ fn a_video_pair_is_rendered_at_a_headset_panel() {
     assert_eq!(manifest["config"]["size"], serde_json::json!([1440, 1600]));
     assert_eq!(manifest["config"]["binocular"]["stereo"], "side-by-side");
 }
+
+/// An eye whose yoked focus lies beyond infinity (the healthy eye in a −1.75 D contact lens
+/// beside the same eye in a plano one, the chart at 6 m: the left eye drives relaxed) is
+/// rendered by the video as `render --binocular` renders it, at the accommodation it exerts,
+/// to the bit: the video's kernels of its own for that eye.
+#[test]
+fn a_video_eye_beyond_infinity_is_the_renders() {
+    let dir = temp_dir("video-beyond");
+    let cache = module_cache();
+    let cache = cache.to_str().unwrap();
+    let options = [
+        "--scene",
+        "chart",
+        "--binocular",
+        "--eye",
+        "healthy",
+        "--correct",
+        "0",
+        "--correct-contact",
+        "--correct-right",
+        "-1.75",
+        "--pupil-mm",
+        "5",
+        "--size",
+        "96x54",
+        "--cache",
+        cache,
+    ];
+    let render_out = dir.join("r.exr");
+    let mut render = vec!["render", "--json", "-o", render_out.to_str().unwrap()];
+    render.extend(options);
+    let summary = json(&render);
+    let right_focus = summary["eyes"][1]["focus_d"].as_f64().unwrap();
+    assert!(right_focus < -1.0, "the right eye's focus {right_focus} D");
+    let video_out = dir.join("v");
+    let mut video = vec![
+        "video",
+        "--duration",
+        "0",
+        "--format",
+        "exr",
+        "--stereo",
+        "separate",
+        "-o",
+        video_out.to_str().unwrap(),
+    ];
+    video.extend(options);
+    let out = ocular_run(&video);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for side in ["left", "right"] {
+        let v = exr_pixels(&video_out.join(format!("frame_000000-{side}.exr")));
+        let r = exr_pixels(&dir.join(format!("r-{side}.exr")));
+        assert!(v == r, "{side}: the video's frame is not the render's");
+    }
+}
