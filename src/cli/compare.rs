@@ -6,7 +6,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::compare_files::{judged_name, map_names, maps_folder, read_truth, write_maps};
+use super::compare_files::{judged_name, map_file, map_names, maps_folder, read_truth, write_maps};
+use super::compare_pair;
 use super::outputs::Outputs;
 use super::raster::parse_frame_size;
 use super::render::load_eye;
@@ -24,7 +25,8 @@ use crate::{Error, Result};
 #[derive(Debug, Args)]
 #[command(after_help = "Examples:\n  \
     ocular compare --scene primitives --eye myopia --size 320x180\n  \
-    ocular compare --scene primitives --eye keratoconus --json kc.json --maps maps/\n\n\
+    ocular compare --scene primitives --eye keratoconus --json kc.json --maps maps/\n  \
+    ocular compare --scene chart --eye healthy --eye-right myopia --json pair.json\n\n\
 Quality is measured against the ground truth on the displayed image: linear values at the input \
 frame's automatic exposure, clamped to [0, 1] (PSNR with a peak of 1; SSIM with Wang et al.'s \
 settings; FLIP is LDR-FLIP at --flip-ppd; in JSON a PSNR of null means identical images). The ground truth computes one exact PSF per 0.001 D \
@@ -33,9 +35,27 @@ pub struct CompareArgs {
     /// Built-in scene or a scene .toml file (rendered at t = 0).
     #[arg(long, value_name = "NAME|FILE", default_value = "primitives")]
     pub scene: String,
-    /// Eye preset or eye .toml file.
+    /// Eye preset or eye .toml file. With --eye-right, the left eye.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
+    /// Compare each eye of a pair (--eye for both, or the left with --eye-right), standing
+    /// where `render --binocular` puts them for the scene's focus and sharing one
+    /// accommodation: each eye's methods against its own truth (docs/binocular.md).
+    #[arg(long)]
+    pub binocular: bool,
+    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub eye_right: Option<String>,
+    /// The right eye's own spectacle or contact lens, "S C x A"; --correct is then the left
+    /// eye's.
+    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
+    pub correct_right: Option<crate::eye::correction::Spectacle>,
+    /// The right eye's own intraocular lens: a power in dioptres, `auto` or `none`.
+    #[arg(long, value_name = "D|auto|none", value_parser = super::binocular::parse_right_iol, allow_hyphen_values = true)]
+    pub iol_d_right: Option<super::binocular::RightIol>,
+    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub ipd_mm: Option<f64>,
     /// Frame size.
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "320x180")]
     pub size: (u32, u32),
@@ -132,6 +152,9 @@ pub enum TruthArg {
 struct Report {
     scene: String,
     eye: String,
+    /// `left` or `right` in a pair's report (absent for one eye).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    side: Option<&'static str>,
     width: u32,
     height: u32,
     focus_d: f64,
@@ -165,35 +188,98 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
         None => None,
     };
     let mut outputs = planned_outputs(args)?;
-    let (truth_in, judged) = read_images(args)?;
-    let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
+    let (mut truth_in, mut judged) = read_images(args)?;
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
+    splat.blend.edge_pixels = args.edge_pixels;
+    let (views, pair) = if compare_pair::asked(args) {
+        let (views, pair) = compare_pair::views(&ctx, args, &scene)?;
+        (views, Some(pair))
+    } else {
+        let eye = args.correction.apply(&load_eye(&args.eye)?, None)?.0;
+        let view = compare_pair::EyeView {
+            side: None,
+            spec: args.eye.clone(),
+            scene,
+            eye,
+            focus_d: None,
+        };
+        (vec![view], None)
+    };
+    let mut reports = Vec::new();
+    for view in &views {
+        let inputs = (truth_in.take(), std::mem::take(&mut judged));
+        reports.push(compare_view(&ctx, args, view, splat, inputs, &mut outputs)?);
+    }
+    if let Some(path) = &args.json {
+        let text = match pair {
+            Some(pair) => serde_json::to_string_pretty(&PairReport {
+                binocular: pair,
+                eyes: reports,
+            }),
+            None => serde_json::to_string_pretty(&reports[0]),
+        }
+        .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
+        image_io::write_text_atomic(outputs.temporary(path), &text)?;
+    }
+    outputs.commit()?;
+    if let Some(mut created) = maps_created {
+        created.keep();
+    }
+    print_written(args);
+    Ok(())
+}
+
+/// `--json` of a pair: its state and each eye's report (left, right).
+#[derive(serde::Serialize)]
+struct PairReport {
+    binocular: compare_pair::PairState,
+    eyes: Vec<Report>,
+}
+
+/// One eye's comparison: its frame, kernels, truth and methods, judged, printed, and its
+/// truth and maps written into `outputs`; returns its report.
+fn compare_view(
+    ctx: &Context,
+    args: &CompareArgs,
+    view: &compare_pair::EyeView,
+    mut splat: crate::render::splat::SplatSettings,
+    (truth_in, judged): (Option<ImageRgba>, Judged),
+    outputs: &mut Outputs,
+) -> Result<Report> {
     let (width, height) = args.size;
     let split = args.edge_pixels == crate::render::blend::EdgePixels::Split;
-    let (frame, eye_state, screen) =
-        super::measured_scene_frame(&ctx, &scene, args.size, args.pupil_mm, split)?;
-    splat.blend.edge_pixels = args.edge_pixels;
+    let (frame, mut eye_state, screen) =
+        super::measured_scene_frame(ctx, &view.scene, args.size, args.pupil_mm, split)?;
+    if let Some(focus_d) = view.focus_d {
+        eye_state.focus_d = focus_d;
+    }
     // Compare what a person sees: every image at the input frame's automatic exposure, which
     // is also the white splat's merge bounds its colour error by.
     let exposure_ev = crate::image_io::Tonemap::auto_exposure_ev_of(&frame.color);
     splat.merge.white = crate::render::splat::display_white(exposure_ev);
     let options = kernel_options(args)?;
-    let kernels = super::frame_kernels(&eye, &frame, eye_state, screen, &options)?;
+    let kernels = super::frame_kernels(&view.eye, &frame, eye_state, screen, &options)?;
     let mut notes = Vec::new();
-    let layers = super::occlusion::scene_layers(&ctx, args.layers, args.size, &mut notes);
+    let layers = super::occlusion::scene_layers(ctx, args.layers, args.size, &mut notes);
     for n in &notes {
         println!("note: {n}");
     }
-    let mut renderer = FrameRenderer::new(&ctx, eye, kernels, options.settings.clone(), splat);
+    let mut renderer = FrameRenderer::new(
+        ctx,
+        view.eye.clone(),
+        kernels,
+        options.settings.clone(),
+        splat,
+    );
     renderer.slice_count = args.slices;
     if let Some(bin) = args.truth_bin_d {
         renderer.reference_dioptre_bin_d = bin;
     }
     let input = frame.input(screen.fov_y_deg);
     let at = Frames {
-        ctx: &ctx,
-        scene: &scene,
+        ctx,
+        scene: &view.scene,
         input: &input,
         eye_state,
         gap_d: splat.blend.group_tolerance_d,
@@ -228,50 +314,47 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let frames = rendered.rows(&truth, layers, &judged_frames);
     let (methods, maps) = judge_rows(&judge, &frames)?;
     let truth_shares = shares(args, truth.method);
-    print_table(args, &at, truth_shares, &views_convergence, &methods);
+    print_table(
+        args,
+        (&at, view),
+        truth_shares,
+        &views_convergence,
+        &methods,
+    );
     if let Some(path) = &args.truth_out {
         image_io::write_exr_rgba(
-            outputs.temporary(path),
+            outputs.temporary(&compare_pair::eye_path(path, view.side)),
             &ImageRgba::new(width, height, truth.color.clone()),
         )?;
     }
     if let Some(dir) = &args.maps {
-        write_maps(&mut outputs, dir, args.size, &frames, &maps, exposure_ev)?;
+        let maps_at = (dir.as_path(), view.side);
+        write_maps(outputs, maps_at, args.size, &frames, &maps, exposure_ev)?;
     }
-    if let Some(path) = &args.json {
-        let report = Report {
-            scene: args.scene.clone(),
-            eye: args.eye.clone(),
-            width,
-            height,
-            focus_d: eye_state.focus_d,
-            pupil_mm: eye_state.pupil_mm,
-            device: ctx.device_info().name.clone(),
-            quality: args.splat.quality.name(),
-            truth: if truth.method == Method::Views {
-                "views"
-            } else {
-                "reference"
-            },
-            truth_shares,
-            truth_bin_d: (truth.method == Method::Reference && args.truth_in.is_none())
-                .then_some(renderer.reference_dioptre_bin_d),
-            views_convergence,
-            splat_warmed_up: !args.no_warmup,
-            flip_ppd: args.flip_ppd,
-            display_exposure_ev: exposure_ev,
-            methods,
-        };
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| Error::input(format!("cannot encode JSON: {e}")))?;
-        image_io::write_text_atomic(outputs.temporary(path), &text)?;
-    }
-    outputs.commit()?;
-    if let Some(mut created) = maps_created {
-        created.keep();
-    }
-    print_written(args);
-    Ok(())
+    Ok(Report {
+        scene: args.scene.clone(),
+        eye: view.spec.clone(),
+        side: view.side,
+        width,
+        height,
+        focus_d: eye_state.focus_d,
+        pupil_mm: eye_state.pupil_mm,
+        device: ctx.device_info().name.clone(),
+        quality: args.splat.quality.name(),
+        truth: if truth.method == Method::Views {
+            "views"
+        } else {
+            "reference"
+        },
+        truth_shares,
+        truth_bin_d: (truth.method == Method::Reference && args.truth_in.is_none())
+            .then_some(renderer.reference_dioptre_bin_d),
+        views_convergence,
+        splat_warmed_up: !args.no_warmup,
+        flip_ppd: args.flip_ppd,
+        display_exposure_ev: exposure_ev,
+        methods,
+    })
 }
 
 fn print_written(args: &CompareArgs) {
@@ -281,13 +364,24 @@ fn print_written(args: &CompareArgs) {
             dir.display()
         );
     }
-    for path in [&args.truth_out, &args.json].into_iter().flatten() {
+    if let Some(path) = &args.truth_out {
+        if compare_pair::asked(args) {
+            for side in crate::render::binocular::SIDES {
+                let file = compare_pair::eye_path(path, Some(side));
+                println!("wrote {}", file.display());
+            }
+        } else {
+            println!("wrote {}", path.display());
+        }
+    }
+    if let Some(path) = &args.json {
         println!("wrote {}", path.display());
     }
 }
 
 /// Options out of range or at odds with each other, refused before anything is read.
 fn check_args(args: &CompareArgs) -> Result<()> {
+    compare_pair::check(args)?;
     if args.views.is_some() && args.truth != TruthArg::Views {
         return Err(Error::input("--views applies to --truth views"));
     }
@@ -334,8 +428,22 @@ fn check_args(args: &CompareArgs) -> Result<()> {
 /// Every file this run writes, checked writable before minutes of rendering.
 fn planned_outputs(args: &CompareArgs) -> Result<Outputs> {
     let mut outputs = Outputs::new();
+    let sides: Vec<Option<&str>> = if compare_pair::asked(args) {
+        crate::render::binocular::SIDES
+            .iter()
+            .map(|s| Some(*s))
+            .collect()
+    } else {
+        vec![None]
+    };
     if let Some(path) = &args.truth_out {
-        outputs.add("--truth-out", path, &["exr"])?;
+        for side in &sides {
+            outputs.add(
+                "--truth-out",
+                &compare_pair::eye_path(path, *side),
+                &["exr"],
+            )?;
+        }
     }
     if let Some(path) = &args.json {
         outputs.add("--json", path, &["json"])?;
@@ -346,7 +454,10 @@ fn planned_outputs(args: &CompareArgs) -> Result<Outputs> {
             args.truth == TruthArg::Views,
             args.layers.unwrap_or(crate::render::raster::DEFAULT_LAYERS) > 1,
         ) {
-            outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
+            for side in &sides {
+                let file = map_file(dir, *side, name);
+                outputs.add("--maps", &file, &["png"])?;
+            }
         }
         for name in args.judge.iter().map(|p| judged_name(p)) {
             outputs.add("--maps", &dir.join(format!("{name}.png")), &["png"])?;
@@ -608,17 +719,20 @@ fn shares(args: &CompareArgs, truth_method: Method) -> &'static str {
 
 fn print_table(
     args: &CompareArgs,
-    at: &Frames<'_>,
+    (at, view): (&Frames<'_>, &compare_pair::EyeView),
     truth_shares: &str,
     views_convergence: &Option<ViewsConvergence>,
     methods: &[MethodResult],
 ) {
     let (width, height) = args.size;
     let (focus_d, pupil_mm) = (at.eye_state.focus_d, at.eye_state.pupil_mm);
+    let side = view
+        .side
+        .map_or(String::new(), |s| format!(", the {s} eye of a pair"));
     println!(
-        "{} through eye {} at {width}×{height}, focus {focus_d:.3} D, pupil {pupil_mm:.2} mm ({})",
+        "{} through eye {}{side} at {width}×{height}, focus {focus_d:.3} D, pupil {pupil_mm:.2} mm ({})",
         args.scene,
-        args.eye,
+        view.spec,
         at.ctx.device_info().name
     );
     println!("  {truth_shares}");

@@ -12,7 +12,7 @@ use crate::{Error, Result};
 /// The images at the display exposure and the SSIM maps (every row but the truth's).
 pub(super) fn write_maps(
     outputs: &mut Outputs,
-    dir: &std::path::Path,
+    (dir, side): (&std::path::Path, Option<&str>),
     (width, height): (u32, u32),
     frames: &[(&RenderedFrame, String, u32)],
     maps: &[Vec<f32>],
@@ -25,11 +25,7 @@ pub(super) fn write_maps(
     for (i, frame) in frames.iter().enumerate() {
         let name = if i == 0 { "truth" } else { frame.1.as_str() };
         let image = ImageRgba::new(width, height, frame.0.color.clone());
-        image_io::write_png(
-            outputs.temporary(&dir.join(format!("{name}.png"))),
-            &image,
-            shown,
-        )?;
+        image_io::write_png(outputs.temporary(&map_file(dir, side, name)), &image, shown)?;
     }
     let flat = Tonemap {
         exposure_ev: 0.0,
@@ -38,12 +34,24 @@ pub(super) fn write_maps(
     for (frame, map) in frames[1..].iter().zip(&maps[1..]) {
         let name = format!("ssim_{}", frame.1);
         image_io::write_png(
-            outputs.temporary(&dir.join(format!("{name}.png"))),
+            outputs.temporary(&map_file(dir, side, &name)),
             &ImageRgba::new(width, height, ssim_map_rgb(map, 0.9)),
             flat,
         )?;
     }
     Ok(())
+}
+
+/// The file of map `name` in `dir`: `NAME.png`, or a pair's `SIDE_NAME.png`.
+pub(super) fn map_file(
+    dir: &std::path::Path,
+    side: Option<&str>,
+    name: &str,
+) -> std::path::PathBuf {
+    match side {
+        Some(side) => dir.join(format!("{side}_{name}.png")),
+        None => dir.join(format!("{name}.png")),
+    }
 }
 
 /// The files `--maps` writes, without extension.

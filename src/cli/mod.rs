@@ -10,6 +10,7 @@ mod bench_pair;
 mod binocular;
 mod compare;
 mod compare_files;
+mod compare_pair;
 pub(crate) mod correction;
 mod devices;
 mod eye;

@@ -166,6 +166,20 @@ impl Scene {
         self
     }
 
+    /// The scene seen from `camera` throughout: its position, orientation and field fixed (the
+    /// camera's keyframes dropped), everything else kept; a new scene to caches, as
+    /// [`Self::with_fov_y_deg`]. One eye of a pair, for the commands that draw a scene from its
+    /// own camera (`ocular compare --binocular`).
+    pub fn seen_from(mut self, camera: Camera) -> Scene {
+        self.id = next_scene_id();
+        self.base_camera = camera;
+        self.base_orientation = Orientation::Angles(camera.yaw_deg, camera.pitch_deg);
+        self.timeline.position = Track3::default();
+        self.timeline.fov_y_deg = Track::default();
+        self.timeline.orientation = None;
+        self
+    }
+
     pub fn from_file(path: &Path) -> Result<Scene> {
         let text = std::fs::read_to_string(path).map_err(|e| match e.kind() {
             std::io::ErrorKind::NotFound => Error::file(path, "scene file not found"),

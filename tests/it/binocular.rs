@@ -1444,3 +1444,89 @@ fn a_video_eye_beyond_infinity_is_the_renders() {
         assert!(v == r, "{side}: the video's frame is not the render's");
     }
 }
+
+/// `ocular compare --binocular` judges each eye of a pair against that eye's own truth: the
+/// pair stands and accommodates as `render --binocular` puts it (the same yoke: driver and
+/// each eye's focus), each eye's splat is held to its truth as one eye's is, and the two
+/// truths are two eyes' (the negative control: one eye's truth judged against the other's is
+/// far from either splat's score).
+#[test]
+fn compare_judges_each_eye_of_a_pair_against_its_own_truth() {
+    let dir = temp_dir("compare-pair");
+    let cache = module_cache();
+    let cache = cache.to_str().unwrap();
+    let pair = [
+        "--scene",
+        "chart",
+        "--eye",
+        "healthy",
+        "--eye-right",
+        "myopia",
+        "--size",
+        "96x54",
+        "--pupil-mm",
+        "4",
+        "--cache",
+        cache,
+    ];
+    let report = dir.join("pair.json");
+    let truth = dir.join("truth.exr");
+    let mut compare = vec![
+        "compare",
+        "--no-slices",
+        "--json",
+        report.to_str().unwrap(),
+        "--truth-out",
+        truth.to_str().unwrap(),
+    ];
+    compare.extend(pair);
+    let out = ocular_run(&compare);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let render_out = dir.join("r.png");
+    let mut render = vec!["render", "--json", "-o", render_out.to_str().unwrap()];
+    render.extend(pair);
+    let rendered = json(&render);
+    assert_eq!(
+        report["binocular"]["driver"], rendered["driver"],
+        "{report}"
+    );
+    let mut splat_db = Vec::new();
+    for e in 0..2 {
+        let eye = &report["eyes"][e];
+        assert_eq!(eye["side"], ["left", "right"][e]);
+        let want = rendered["eyes"][e]["focus_d"].as_f64().unwrap();
+        let got = eye["focus_d"].as_f64().unwrap();
+        assert!(
+            (got - want).abs() < 1e-9,
+            "eye {e}: focus {got} D, render's {want} D"
+        );
+        let splat = eye["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == "splat")
+            .unwrap();
+        let db = splat["psnr_db"].as_f64().unwrap();
+        assert!(db > 60.0, "eye {e}: splat {db:.1} dB from its truth");
+        splat_db.push(db);
+    }
+    let [left, right] = ["left", "right"].map(|s| exr_pixels(&dir.join(format!("truth-{s}.exr"))));
+    let across = psnr_at_peak(&left, &right);
+    eprintln!("splat {splat_db:?} dB against each eye's truth; the truths {across:.1} dB apart");
+    assert!(
+        across < 40.0,
+        "the two eyes' truths are {across:.1} dB apart"
+    );
+    // what judges one eye's frame only is refused with a pair
+    let mut refused = compare.clone();
+    refused.extend(["--truth-in", truth.to_str().unwrap()]);
+    let out = ocular_run(&refused);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--truth-in judges one eye's frame"));
+}
