@@ -8,9 +8,10 @@
 #
 # Order: the draw at 2, 4 and 8 samples (`bench --draw-samples`, primitives and colonnade
 # through the myopic eye, `fast`) at 3840×2160 then 1280×720; the same at 4 samples unshaded
-# (`--draw-unshaded`) at 3840×2160; then `bench --binocular --headset vive-pro|quest3
+# (`--draw-unshaded`) at 3840×2160, and with its colour in half floats (`--draw-half-colour`) at
+# both sizes; then `bench --binocular --headset vive-pro|quest3
 # --quality fast` for primitives / myopia and colonnade / astigmatism. One JSON per run:
-# samplesN_SCENE_SIZE, unshaded_SCENE_SIZE, pair_HEADSET_SCENE_EYE. Summarise with
+# samplesN_SCENE_SIZE, half_SCENE_SIZE, unshaded_SCENE_SIZE, pair_HEADSET_SCENE_EYE. Summarise with
 # `tools/gpu_draw_table.py OUT_DIR`.
 #
 # Environment: FRAMES (default 10), WARMUP (default 3), RUN_TIMEOUT_S (default 60), DEADLINE_S
@@ -37,6 +38,13 @@ for size in 3840x2160 1280x720; do
             run "samples${n}_${scene}_${size}" "$bin" --scene "$scene" --eye myopia \
                 --size "$size" --quality fast --draw-samples "$n"
         done
+    done
+done
+# the multisampled colour in half floats (`--draw-half-colour`): 16 bytes a sample, not 24
+for size in 3840x2160 1280x720; do
+    for scene in primitives colonnade; do
+        run "half_${scene}_${size}" "$bin" --scene "$scene" --eye myopia --size "$size" \
+            --quality fast --draw-half-colour
     done
 done
 for scene in primitives colonnade; do

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The tables of tools/gpu_draw.sh's runs: the draw's GPU time at 2, 4 and 8 samples per pixel
-(and unshaded at 4), and two eyes at a headset's panel against its refresh interval.
+(and at 4 unshaded, and with its colour in half floats), and two eyes at a headset's panel against its refresh interval.
 
     tools/gpu_draw_table.py OUT_DIR
 
@@ -24,8 +24,8 @@ def main():
     print(f"device: {device(folder)}\n")
     print("The draw (GPU ms per frame; raster pass alone in brackets), primitives and colonnade "
           "through the myopic eye, `fast`\n")
-    print("| scene | size | 2 samples | 4 samples | 8 samples | 4 unshaded | 8 / 2 |")
-    print("|---|---|---|---|---|---|---|")
+    print("| scene | size | 2 samples | 4 samples | 8 samples | 4 unshaded | 4, half colour | 8 / 2 |")
+    print("|---|---|---|---|---|---|---|---|")
     for size in ["3840x2160", "1280x720"]:
         for scene in ["primitives", "colonnade"]:
             cells, draws = [], {}
@@ -36,8 +36,9 @@ def main():
                     continue
                 draws[n] = split(r)[0]
                 cells.append(f"{draws[n]:.2f} ({raster_ms(r):.2f})")
-            u = load(folder, f"unshaded_{scene}_{size}")
-            cells.append("—" if u is None else f"{split(u)[0]:.2f} ({raster_ms(u):.2f})")
+            for prefix in ("unshaded", "half"):
+                u = load(folder, f"{prefix}_{scene}_{size}")
+                cells.append("—" if u is None else f"{split(u)[0]:.2f} ({raster_ms(u):.2f})")
             ratio = f"{draws[8] / draws[2]:.2f}×" if 2 in draws and 8 in draws else "—"
             print(f"| {scene} | {size} | " + " | ".join(cells) + f" | {ratio} |")
     print("\nTwo eyes at a headset's panel, `fast` (GPU ms per pair, both eyes' passes; "

@@ -78,6 +78,11 @@ pub struct BenchArgs {
     /// its time follows them. Edges and mixed pixels are only as fine as the samples.
     #[arg(long, value_name = "N", value_parser = parse_draw_samples)]
     pub draw_samples: Option<u32>,
+    /// A diagnostic of the draw: its multisampled colour in half floats (8 bytes a sample
+    /// instead of 16), to see how its time follows the bytes it writes. Light over 65504
+    /// cd/m² clips, so the frame is not every frame's.
+    #[arg(long)]
+    pub draw_half_colour: bool,
     /// With --binocular: the right eye (a preset or an eye file); --eye is then the left.
     #[arg(long, value_name = "NAME|FILE")]
     pub eye_right: Option<String>,
@@ -186,6 +191,8 @@ struct Report {
     draw_unshaded: bool,
     /// Samples per pixel the draw used (4 but under `--draw-samples`).
     draw_samples: u32,
+    /// `--draw-half-colour`: the draw's multisampled colour was half floats.
+    draw_half_colour: bool,
 }
 
 #[derive(Clone, Copy, Debug, Default, serde::Serialize)]
@@ -447,6 +454,7 @@ impl Report {
             headset: None,
             draw_unshaded: false,
             draw_samples: crate::render::MSAA_SAMPLES,
+            draw_half_colour: false,
         }
     }
 }
@@ -461,7 +469,7 @@ fn parse_draw_samples(s: &str) -> std::result::Result<u32, String> {
 }
 
 /// The rasteriser of a bench run: every frame's, or the draw's diagnostics (`--draw-unshaded`,
-/// `--draw-samples`).
+/// `--draw-samples`, `--draw-half-colour`).
 fn draw_rasterizer(ctx: &Context, args: &BenchArgs) -> Result<Rasterizer> {
     use crate::render::{SurfaceInputs, MSAA_SAMPLES};
     let inputs = if args.draw_unshaded {
@@ -474,7 +482,10 @@ fn draw_rasterizer(ctx: &Context, args: &BenchArgs) -> Result<Rasterizer> {
     if samples != MSAA_SAMPLES {
         println!("note: --draw-samples {samples}: edges are not every frame's; time the draw only");
     }
-    Rasterizer::with_samples(ctx, inputs, samples).map_err(|e| {
+    if args.draw_half_colour {
+        println!("note: --draw-half-colour: light over 65504 cd/m² clips; time the draw only");
+    }
+    Rasterizer::for_diagnostic(ctx, inputs, samples, args.draw_half_colour).map_err(|e| {
         if samples == MSAA_SAMPLES {
             e
         } else {
@@ -621,6 +632,7 @@ pub fn run(cli: &Cli, args: &BenchArgs) -> Result<()> {
     report.headset = args.headset.map(|h| h.summary());
     report.draw_unshaded = args.draw_unshaded;
     report.draw_samples = args.draw_samples.unwrap_or(crate::render::MSAA_SAMPLES);
+    report.draw_half_colour = args.draw_half_colour;
     write_report(&report, args, outputs)
 }
 

@@ -222,6 +222,17 @@ pub struct Rasterizer {
     /// Whether colour is resolved in compute (raster.comp) rather than by the render pass:
     /// on GPUs (see the module's header).
     colour_in_compute: bool,
+    /// The multisampled colour in half floats ([`Self::for_diagnostic`] only).
+    half_colour: bool,
+}
+
+/// The multisampled colour's format: single floats, or half ones for the draw's diagnostic.
+fn colour_format(half: bool) -> TexelFormat {
+    if half {
+        TexelFormat::Rgba16Float
+    } else {
+        TexelFormat::Rgba32Float
+    }
 }
 
 impl Rasterizer {
@@ -240,15 +251,30 @@ impl Rasterizer {
     /// [`MSAA_SAMPLES`]: a timing diagnostic (`ocular bench --draw-samples`), since coverage
     /// and mixed pixels are only as fine as the samples.
     pub fn with_samples(ctx: &Context, inputs: SurfaceInputs, samples: u32) -> Result<Rasterizer> {
+        Self::for_diagnostic(ctx, inputs, samples, false)
+    }
+
+    /// As [`Self::with_samples`], and with `half_colour` the multisampled colour in half
+    /// floats (8 bytes a sample where every frame writes 16), resolved in compute on any
+    /// device: a timing diagnostic (`ocular bench --draw-half-colour`) of how the draw follows
+    /// the bytes it writes. Values over 65504 cd/m² clip, so no frame is drawn so.
+    pub fn for_diagnostic(
+        ctx: &Context,
+        inputs: SurfaceInputs,
+        samples: u32,
+        half_colour: bool,
+    ) -> Result<Rasterizer> {
         let on_gpu = ctx.device_info().kind != crate::gpu::DeviceKind::Cpu;
-        Self::build(ctx, inputs, samples, on_gpu)
+        let mut r = Self::build(ctx, inputs, samples, on_gpu || half_colour, half_colour)?;
+        r.half_colour = half_colour;
+        Ok(r)
     }
 
     /// A rasteriser that resolves colour in compute (`true`) or by the render pass, whatever
     /// the device: the two give the same frames (`tests/it/raster.rs` holds them to it on
     /// lavapipe, where [`Self::new`] resolves by the render pass).
     pub fn with_colour_resolve(ctx: &Context, in_compute: bool) -> Result<Rasterizer> {
-        Self::build(ctx, SurfaceInputs::Covered, MSAA_SAMPLES, in_compute)
+        Self::build(ctx, SurfaceInputs::Covered, MSAA_SAMPLES, in_compute, false)
     }
 
     fn build(
@@ -256,19 +282,16 @@ impl Rasterizer {
         inputs: SurfaceInputs,
         samples: u32,
         colour_in_compute: bool,
+        half_colour: bool,
     ) -> Result<Rasterizer> {
         if !RASTER_SAMPLE_COUNTS.contains(&samples) {
             return Err(crate::Error::input(format!(
                 "raster samples per pixel: {samples}; allowed: 2, 4 or 8"
             )));
         }
-        let pipeline = Self::pipeline(ctx, false, inputs, (samples, colour_in_compute))?;
-        let peel = Self::pipeline(
-            ctx,
-            true,
-            SurfaceInputs::Covered,
-            (samples, colour_in_compute),
-        )?;
+        let draw = (samples, colour_in_compute, half_colour);
+        let pipeline = Self::pipeline(ctx, false, inputs, draw)?;
+        let peel = Self::pipeline(ctx, true, SurfaceInputs::Covered, draw)?;
         let resolve = ComputePipeline::builder("resolve", crate::shaders::RENDER_RASTER_COMP)
             .push_constants::<ResolvePush>()
             .build(ctx)?;
@@ -300,17 +323,19 @@ impl Rasterizer {
             mixed_pixels: false,
             samples,
             colour_in_compute,
+            half_colour,
         })
     }
 
     /// The raster pipeline, or its depth-peeling variant (one more binding: the previous
     /// layer's samples, `previous_samples` in glsl/render/raster_peel.frag), with `samples`
-    /// per pixel and its colour resolved by the render pass unless `colour_in_compute`.
+    /// per pixel, its colour resolved by the render pass unless `colour_in_compute`, and in
+    /// half floats with `half_colour` (a diagnostic: [`Self::for_diagnostic`]).
     fn pipeline(
         ctx: &Context,
         peel: bool,
         inputs: SurfaceInputs,
-        (samples, colour_in_compute): (u32, bool),
+        (samples, colour_in_compute, half_colour): (u32, bool, bool),
     ) -> Result<GraphicsPipeline> {
         let stride = std::mem::size_of::<Vertex>() as u32;
         let (name, fragment) = match (peel, inputs) {
@@ -354,7 +379,7 @@ impl Rasterizer {
                 )
                 .push_constants::<MaterialPush>()
                 .samples(samples)
-                .color_target(TexelFormat::Rgba32Float, !colour_in_compute)
+                .color_target(colour_format(half_colour), !colour_in_compute)
                 .color_target(TexelFormat::R32Float, false)
                 .depth_target(TexelFormat::D32Float, DepthCompare::Greater)
                 .build(ctx)?,
@@ -423,7 +448,7 @@ impl Rasterizer {
         let colour_read = self.colour_in_compute || self.mixed_pixels;
         let color_ms = target(
             "raster colour (MSAA)",
-            TexelFormat::Rgba32Float,
+            colour_format(self.half_colour),
             attachment(false, colour_read, self.samples),
         )?;
         let view_depth_ms = target(
