@@ -48,26 +48,112 @@ pub fn parse_right_iol(text: &str) -> std::result::Result<RightIol, String> {
         .map_err(|e| format!("{e} (or none)"))
 }
 
+/// The options of a pair of eyes, shared by `render`, `video` and `compare`.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct PairArgs {
+    /// Two eyes (--eye for both, or the left with --eye-right): the scene's camera is the
+    /// point between them, both converge on the focus point and share one accommodation
+    /// (docs/binocular.md).
+    #[arg(long)]
+    pub binocular: bool,
+    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub eye_right: Option<String>,
+    /// The right eye's own spectacle or contact lens, "S C x A" (as --correct, whose
+    /// --vertex-mm and --correct-contact it shares); --correct is then the left eye's.
+    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
+    pub correct_right: Option<crate::eye::correction::Spectacle>,
+    /// The right eye's own intraocular lens: a power in dioptres (-10 to 40), `auto` (the
+    /// emmetropic one) or `none` (the right eye keeps its crystalline lens); --iol-d is then
+    /// the left eye's. A pseudophakic monovision pair: --iol-d auto --iol-d-right with a
+    /// stronger lens.
+    #[arg(long, value_name = "D|auto|none", value_parser = parse_right_iol, allow_hyphen_values = true)]
+    pub iol_d_right: Option<RightIol>,
+    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
+    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
+    pub ipd_mm: Option<f64>,
+}
+
+impl PairArgs {
+    /// Whether the options ask for two eyes.
+    pub fn asked(&self) -> bool {
+        self.binocular || self.eye_right.is_some()
+    }
+
+    /// Refuses a pair's options given without a pair (`others`: the command's own, named),
+    /// and an interpupillary distance out of range.
+    pub fn check(&self, others: &[(&str, bool)]) -> Result<()> {
+        if !self.asked() {
+            let stray = [
+                ("--ipd-mm", self.ipd_mm.is_some()),
+                ("--correct-right", self.correct_right.is_some()),
+                ("--iol-d-right", self.iol_d_right.is_some()),
+            ];
+            if let Some((name, _)) = stray.iter().chain(others).find(|(_, on)| *on) {
+                return Err(Error::input(format!(
+                    "{name} applies to two eyes: add --binocular (or --eye-right)"
+                )));
+            }
+        }
+        if let Some(ipd) = self.ipd_mm {
+            binocular::check_ipd_mm(ipd).map_err(Error::input)?;
+        }
+        Ok(())
+    }
+
+    /// The eyes' specs (left, right) and the eyes they load: `eye` (the command's --eye) for
+    /// both, or the left with --eye-right; a file is named by the option that gave it.
+    pub fn eyes(&self, eye: &str) -> Result<([String; 2], [Eye; 2])> {
+        let right = self.eye_right.as_deref().unwrap_or(eye);
+        let option = if self.eye_right.is_some() {
+            "--eye-right"
+        } else {
+            "--eye"
+        };
+        let loaded = [
+            crate::render::frame_plan::load_eye("--eye", eye)?,
+            crate::render::frame_plan::load_eye(option, right)?,
+        ];
+        Ok(([eye.to_string(), right.to_string()], loaded))
+    }
+
+    /// The right eye's correction, `left`'s but for its own lenses ([`right_correction`]).
+    pub fn right_correction(&self, left: &Correction) -> Correction {
+        right_correction(left, self.correct_right, self.iol_d_right)
+    }
+}
+
+/// The right eye's correction: the left eye's (`--correct`, `--iol-d` and what goes with them)
+/// with `--correct-right` and `--iol-d-right` in place of the left's lens, where given. Every
+/// command that takes a pair (render, video, compare) reads it so.
+fn right_correction(
+    left: &Correction,
+    correct_right: Option<crate::eye::correction::Spectacle>,
+    iol_d_right: Option<RightIol>,
+) -> Correction {
+    Correction {
+        spectacle: correct_right.or(left.spectacle),
+        iol: match iol_d_right {
+            Some(RightIol::None) => None,
+            Some(RightIol::Power(p)) => Some(p),
+            None => left.iol,
+        },
+        ..left.clone()
+    }
+}
+
 /// Whether the options ask for two eyes.
 pub fn asked(args: &RenderArgs) -> bool {
-    args.binocular || args.eye_right.is_some()
+    args.pair.asked()
 }
 
 /// Refuses the binocular options without a binocular render, and what it cannot take yet.
 pub fn check(args: &RenderArgs) -> Result<()> {
+    args.pair.check(&[
+        ("--stereo", args.stereo.is_some()),
+        ("--color-right", args.color_right.is_some()),
+    ])?;
     if !asked(args) {
-        let stray = [
-            ("--ipd-mm", args.ipd_mm.is_some()),
-            ("--stereo", args.stereo.is_some()),
-            ("--correct-right", args.correct_right.is_some()),
-            ("--iol-d-right", args.iol_d_right.is_some()),
-            ("--color-right", args.color_right.is_some()),
-        ];
-        if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
-            return Err(Error::input(format!(
-                "{name} applies to two eyes: add --binocular (or --eye-right)"
-            )));
-        }
         return Ok(());
     }
     if args.method != Method::Splat {
@@ -78,10 +164,7 @@ pub fn check(args: &RenderArgs) -> Result<()> {
             "--binocular does not take --off-axis yet (each eye's field would need its own plan)",
         ));
     }
-    if let Some(ipd) = args.ipd_mm {
-        binocular::check_ipd_mm(ipd).map_err(Error::input)?;
-    }
-    if args.color.is_some() && args.ipd_mm.is_some() {
+    if args.color.is_some() && args.pair.ipd_mm.is_some() {
         return Err(Error::input(
             "--ipd-mm places the eyes in a scene; a stereo pair from files was rendered with its \
              own camera separation",
@@ -151,15 +234,8 @@ struct Summary {
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     super::render::check_args(args)?;
     let quality = args.splat.quality;
-    let specs = [
-        args.eye.clone(),
-        args.eye_right.clone().unwrap_or_else(|| args.eye.clone()),
-    ];
-    let eyes: Vec<Eye> = specs
-        .iter()
-        .map(|s| super::render::load_eye(s))
-        .collect::<Result<_>>()?;
-    let ipd_mm = args.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM);
+    let (specs, eyes) = args.pair.eyes(&args.eye)?;
+    let ipd_mm = args.pair.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM);
     if !(args.time.is_finite() && args.time >= 0.0) {
         return Err(Error::input(format!(
             "--time {} must be a non-negative number of seconds",
@@ -180,15 +256,7 @@ pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     };
     let corrections = [
         base.correction.clone(),
-        Correction {
-            spectacle: args.correct_right.or(base.correction.spectacle),
-            iol: match args.iol_d_right {
-                Some(RightIol::None) => None,
-                Some(RightIol::Power(p)) => Some(p),
-                None => base.correction.iol,
-            },
-            ..base.correction.clone()
-        },
+        args.pair.right_correction(&base.correction),
     ];
     // A stereo pair from files is read before anything is written or the GPU is started.
     let files_in = match &args.color {

@@ -38,24 +38,12 @@ pub struct CompareArgs {
     /// Eye preset or eye .toml file. With --eye-right, the left eye.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
-    /// Compare each eye of a pair (--eye for both, or the left with --eye-right), standing
-    /// where `render --binocular` puts them for the scene's focus and sharing one
-    /// accommodation: each eye's methods against its own truth (docs/binocular.md).
-    #[arg(long)]
-    pub binocular: bool,
-    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
-    #[arg(long, value_name = "NAME|FILE")]
-    pub eye_right: Option<String>,
-    /// The right eye's own spectacle or contact lens, "S C x A"; --correct is then the left
-    /// eye's.
-    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
-    pub correct_right: Option<crate::eye::correction::Spectacle>,
-    /// The right eye's own intraocular lens: a power in dioptres, `auto` or `none`.
-    #[arg(long, value_name = "D|auto|none", value_parser = super::binocular::parse_right_iol, allow_hyphen_values = true)]
-    pub iol_d_right: Option<super::binocular::RightIol>,
-    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63).
-    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
-    pub ipd_mm: Option<f64>,
+    /// Compare each eye of a pair (--binocular, --eye-right and the right eye's options, as
+    /// in render), standing where `render --binocular` puts them for the scene's focus and
+    /// sharing one accommodation: each eye's methods against its own truth
+    /// (docs/binocular.md).
+    #[command(flatten)]
+    pub pair: super::binocular::PairArgs,
     /// Frame size.
     #[arg(long, value_name = "WxH", value_parser = parse_frame_size, default_value = "320x180")]
     pub size: (u32, u32),

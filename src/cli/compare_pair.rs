@@ -4,7 +4,6 @@
 //! judged against that eye's own truth, drawn from where the eye stands. As for one eye,
 //! compare draws without a spectacle's magnification (every method and the truth alike).
 
-use super::binocular::RightIol;
 use super::compare::CompareArgs;
 use crate::eye::Eye;
 use crate::gpu::Context;
@@ -17,22 +16,13 @@ use crate::{Error, Result};
 
 /// Whether the options ask for two eyes.
 pub(super) fn asked(args: &CompareArgs) -> bool {
-    args.binocular || args.eye_right.is_some()
+    args.pair.asked()
 }
 
 /// Refuses the pair's options without a pair, and what a pair cannot take.
 pub(super) fn check(args: &CompareArgs) -> Result<()> {
+    args.pair.check(&[])?;
     if !asked(args) {
-        let stray = [
-            ("--ipd-mm", args.ipd_mm.is_some()),
-            ("--correct-right", args.correct_right.is_some()),
-            ("--iol-d-right", args.iol_d_right.is_some()),
-        ];
-        if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
-            return Err(Error::input(format!(
-                "{name} applies to two eyes: add --binocular (or --eye-right)"
-            )));
-        }
         return Ok(());
     }
     let one_eye = [
@@ -44,9 +34,6 @@ pub(super) fn check(args: &CompareArgs) -> Result<()> {
         return Err(Error::input(format!(
             "{name} judges one eye's frame: leave out --binocular"
         )));
-    }
-    if let Some(ipd) = args.ipd_mm {
-        binocular::check_ipd_mm(ipd).map_err(Error::input)?;
     }
     Ok(())
 }
@@ -81,24 +68,9 @@ pub(super) fn views(
     args: &CompareArgs,
     scene: &Scene,
 ) -> Result<(Vec<EyeView>, PairState)> {
-    let specs = [
-        args.eye.clone(),
-        args.eye_right.clone().unwrap_or_else(|| args.eye.clone()),
-    ];
-    let base = [
-        super::render::load_eye(&specs[0])?,
-        super::render::load_eye(&specs[1])?,
-    ];
+    let (specs, base) = args.pair.eyes(&args.eye)?;
     let left = args.correction.correction();
-    let right = Correction {
-        spectacle: args.correct_right.or(left.spectacle),
-        iol: match args.iol_d_right {
-            Some(RightIol::None) => None,
-            Some(RightIol::Power(p)) => Some(p),
-            None => left.iol,
-        },
-        ..left.clone()
-    };
+    let right = args.pair.right_correction(&left);
     let corrections = [left, right];
     let corrected = [
         corrected_eye(&base[0], &corrections[0], None)?,
@@ -111,7 +83,7 @@ pub(super) fn views(
         signed_far_point_d(&corrected[1].0, state.pupil_mm, &settings)?,
     ];
     let amplitude_d = [0, 1].map(|e| corrected[e].1.accommodation_max_d);
-    let ipd_mm = args.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM);
+    let ipd_mm = args.pair.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM);
     let camera = scene.at_time(0.0).camera;
     let instant = pair_instant(
         &camera,

@@ -84,27 +84,8 @@ pub struct RenderArgs {
     /// eye.
     #[arg(long, value_name = "NAME|FILE", default_value = "myopia")]
     pub eye: String,
-    /// Render the scene through two eyes (--eye for both, or the left with --eye-right): the
-    /// scene's camera is the point between them, both converge on the focus point and share
-    /// one accommodation (docs/binocular.md).
-    #[arg(long)]
-    pub binocular: bool,
-    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
-    #[arg(long, value_name = "NAME|FILE")]
-    pub eye_right: Option<String>,
-    /// The right eye's own spectacle or contact lens, "S C x A" (as --correct, whose
-    /// --vertex-mm and --correct-contact it shares); --correct is then the left eye's.
-    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
-    pub correct_right: Option<crate::eye::correction::Spectacle>,
-    /// The right eye's own intraocular lens: a power in dioptres (-10 to 40), `auto` (the
-    /// emmetropic one) or `none` (the right eye keeps its crystalline lens); --iol-d is then
-    /// the left eye's. A pseudophakic monovision pair: --iol-d auto --iol-d-right with a
-    /// stronger lens.
-    #[arg(long, value_name = "D|auto|none", value_parser = super::binocular::parse_right_iol, allow_hyphen_values = true)]
-    pub iol_d_right: Option<super::binocular::RightIol>,
-    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
-    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
-    pub ipd_mm: Option<f64>,
+    #[command(flatten)]
+    pub pair: super::binocular::PairArgs,
     /// How a binocular pair is written (default separate: -o view.png writes view-left.png
     /// and view-right.png).
     #[arg(long, value_enum)]

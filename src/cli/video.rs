@@ -82,25 +82,8 @@ pub struct VideoArgs {
     /// `uncorrected` is the --eye without --correct/--iol-d.
     #[arg(long, value_name = "NAME|FILE|uncorrected")]
     pub side_by_side: Option<String>,
-    /// Render through two eyes (--eye for both, or the left with --eye-right): the scene's
-    /// camera is the point between them, both converge on each frame's focus straight ahead
-    /// and share one accommodation and pupil, as `render --binocular` (docs/binocular.md).
-    #[arg(long)]
-    pub binocular: bool,
-    /// The right eye of a binocular pair (a preset or an eye file); --eye is then the left.
-    #[arg(long, value_name = "NAME|FILE")]
-    pub eye_right: Option<String>,
-    /// The right eye's own spectacle or contact lens, "S C x A" (as --correct, whose
-    /// --vertex-mm and --correct-contact it shares); --correct is then the left eye's.
-    #[arg(long, value_name = "S C x A", value_parser = super::correction::parse_correct, allow_hyphen_values = true)]
-    pub correct_right: Option<crate::eye::correction::Spectacle>,
-    /// The right eye's own intraocular lens: a power in dioptres (-10 to 40), `auto` or `none`
-    /// (the right eye keeps its crystalline lens); --iol-d is then the left eye's.
-    #[arg(long, value_name = "D|auto|none", value_parser = super::binocular::parse_right_iol, allow_hyphen_values = true)]
-    pub iol_d_right: Option<super::binocular::RightIol>,
-    /// Interpupillary distance of a binocular pair in mm (40 to 80; default 63, the adult mean).
-    #[arg(long, value_name = "MM", allow_negative_numbers = true)]
-    pub ipd_mm: Option<f64>,
+    #[command(flatten)]
+    pub pair: super::binocular::PairArgs,
     /// How a binocular pair is written (default side-by-side: one frame twice as wide, the left
     /// eye on the left; separate: frame_NNNNNN-left and -right files; anaglyph: red-cyan).
     #[arg(long, value_enum)]
@@ -513,9 +496,14 @@ fn export_config(
         layers: args.layers.filter(|&k| k > 1),
         binocular: if video_pair::asked(args) {
             Some(manifest::PairConfig {
-                eye_right: args.eye_right.clone().unwrap_or_else(|| args.eye.clone()),
+                eye_right: args
+                    .pair
+                    .eye_right
+                    .clone()
+                    .unwrap_or_else(|| args.eye.clone()),
                 eye_right_sha256: eye_sha256(&eyes[1].1)?,
                 ipd_mm: args
+                    .pair
                     .ipd_mm
                     .unwrap_or(crate::render::binocular::DEFAULT_IPD_MM),
                 stereo: video_pair::stereo_name(args).to_string(),

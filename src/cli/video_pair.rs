@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use super::binocular::{RightIol, StereoOutput};
+use super::binocular::StereoOutput;
 use super::video::VideoArgs;
 use super::video_frame;
 use crate::eye::age::HofstetterLine;
@@ -27,23 +27,13 @@ use crate::{Error, Result};
 
 /// Whether the options ask for two eyes.
 pub(super) fn asked(args: &VideoArgs) -> bool {
-    args.binocular || args.eye_right.is_some()
+    args.pair.asked()
 }
 
 /// Refuses the pair's options without a pair, and what a pair cannot take.
 pub(super) fn check(args: &VideoArgs) -> Result<()> {
+    args.pair.check(&[("--stereo", args.stereo.is_some())])?;
     if !asked(args) {
-        let stray = [
-            ("--ipd-mm", args.ipd_mm.is_some()),
-            ("--stereo", args.stereo.is_some()),
-            ("--correct-right", args.correct_right.is_some()),
-            ("--iol-d-right", args.iol_d_right.is_some()),
-        ];
-        if let Some((name, _)) = stray.iter().find(|(_, on)| *on) {
-            return Err(Error::input(format!(
-                "{name} applies to two eyes: add --binocular (or --eye-right)"
-            )));
-        }
         return Ok(());
     }
     if args.side_by_side.is_some() {
@@ -56,9 +46,6 @@ pub(super) fn check(args: &VideoArgs) -> Result<()> {
         return Err(Error::input(
             "--binocular does not take --off-axis yet (each eye's field would need its own plan)",
         ));
-    }
-    if let Some(ipd) = args.ipd_mm {
-        binocular::check_ipd_mm(ipd).map_err(Error::input)?;
     }
     if args.mp4.is_some() && stereo(args) == StereoOutput::Separate {
         return Err(Error::input(
@@ -112,31 +99,9 @@ pub(super) struct PairSetup {
 
 impl PairSetup {
     pub fn from_args(args: &VideoArgs) -> Result<PairSetup> {
-        let specs = [
-            args.eye.clone(),
-            args.eye_right.clone().unwrap_or_else(|| args.eye.clone()),
-        ];
-        let base = [
-            crate::render::frame_plan::load_eye("--eye", &specs[0])?,
-            crate::render::frame_plan::load_eye(
-                if args.eye_right.is_some() {
-                    "--eye-right"
-                } else {
-                    "--eye"
-                },
-                &specs[1],
-            )?,
-        ];
+        let (specs, base) = args.pair.eyes(&args.eye)?;
         let left = args.correction.correction();
-        let right = Correction {
-            spectacle: args.correct_right.or(left.spectacle),
-            iol: match args.iol_d_right {
-                Some(RightIol::None) => None,
-                Some(RightIol::Power(p)) => Some(p),
-                None => left.iol,
-            },
-            ..left.clone()
-        };
+        let right = args.pair.right_correction(&left);
         let corrections = [left, right];
         let age = (args.age, HofstetterLine::Mean);
         let eyes = [
@@ -148,7 +113,7 @@ impl PairSetup {
             base,
             corrections,
             age,
-            ipd_m: args.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM) * 1e-3,
+            ipd_m: args.pair.ipd_mm.unwrap_or(binocular::DEFAULT_IPD_MM) * 1e-3,
             eyes,
         })
     }
