@@ -142,18 +142,13 @@ fn right_correction(
     }
 }
 
-/// Whether the options ask for two eyes.
-pub fn asked(args: &RenderArgs) -> bool {
-    args.pair.asked()
-}
-
 /// Refuses the binocular options without a binocular render, and what it cannot take yet.
 pub fn check(args: &RenderArgs) -> Result<()> {
     args.pair.check(&[
         ("--stereo", args.stereo.is_some()),
         ("--color-right", args.color_right.is_some()),
     ])?;
-    if !asked(args) {
+    if !args.pair.asked() {
         return Ok(());
     }
     if args.method != Method::Splat {

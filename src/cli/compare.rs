@@ -180,7 +180,7 @@ pub fn run(cli: &Cli, args: &CompareArgs) -> Result<()> {
     let scene = Scene::load(&args.scene)?;
     let ctx = Context::new(&cli.context_options())?;
     splat.blend.edge_pixels = args.edge_pixels;
-    let (views, pair) = if compare_pair::asked(args) {
+    let (views, pair) = if args.pair.asked() {
         let (views, pair) = compare_pair::views(&ctx, args, &scene)?;
         (views, Some(pair))
     } else {
@@ -353,7 +353,7 @@ fn print_written(args: &CompareArgs) {
         );
     }
     if let Some(path) = &args.truth_out {
-        if compare_pair::asked(args) {
+        if args.pair.asked() {
             for side in crate::render::binocular::SIDES {
                 let file = compare_pair::eye_path(path, Some(side));
                 println!("wrote {}", file.display());
@@ -416,7 +416,7 @@ fn check_args(args: &CompareArgs) -> Result<()> {
 /// Every file this run writes, checked writable before minutes of rendering.
 fn planned_outputs(args: &CompareArgs) -> Result<Outputs> {
     let mut outputs = Outputs::new();
-    let sides: Vec<Option<&str>> = if compare_pair::asked(args) {
+    let sides: Vec<Option<&str>> = if args.pair.asked() {
         crate::render::binocular::SIDES
             .iter()
             .map(|s| Some(*s))

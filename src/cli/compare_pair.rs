@@ -14,15 +14,10 @@ use crate::render::frame_plan::{corrected_eye, Correction};
 use crate::scene::Scene;
 use crate::{Error, Result};
 
-/// Whether the options ask for two eyes.
-pub(super) fn asked(args: &CompareArgs) -> bool {
-    args.pair.asked()
-}
-
 /// Refuses the pair's options without a pair, and what a pair cannot take.
 pub(super) fn check(args: &CompareArgs) -> Result<()> {
     args.pair.check(&[])?;
-    if !asked(args) {
+    if !args.pair.asked() {
         return Ok(());
     }
     let one_eye = [

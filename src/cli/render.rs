@@ -505,7 +505,7 @@ fn pupil_asked(args: &RenderArgs) -> PupilAsked<'static> {
 
 pub fn run(cli: &Cli, args: &RenderArgs) -> Result<()> {
     super::binocular::check(args)?;
-    if super::binocular::asked(args) {
+    if args.pair.asked() {
         return super::binocular::run(cli, args);
     }
     let mut splat = check_args(args)?;

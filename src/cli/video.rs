@@ -247,7 +247,9 @@ pub fn run(cli: &Cli, args: &VideoArgs) -> Result<()> {
         None => (0, count),
     };
     // The pupil model's age also sets the amplitude of accommodation, as in render.
-    let pair = video_pair::asked(args)
+    let pair = args
+        .pair
+        .asked()
         .then(|| video_pair::PairSetup::from_args(args))
         .transpose()?;
     let eyes = match &pair {
@@ -494,7 +496,7 @@ fn export_config(
         pupil_mm: args.pupil_mm,
         exposure_ev: args.exposure,
         layers: args.layers.filter(|&k| k > 1),
-        binocular: if video_pair::asked(args) {
+        binocular: if args.pair.asked() {
             Some(manifest::PairConfig {
                 eye_right: args
                     .pair
@@ -523,11 +525,7 @@ fn frames_to_render(args: &VideoArgs, range: std::ops::Range<usize>) -> Vec<usiz
     let mut rejected = 0usize;
     for i in range {
         let names = video_pair::frame_names(args, i);
-        let present: Vec<std::path::PathBuf> = names
-            .iter()
-            .map(|name| args.output.join(name))
-            .filter(|path| path.exists())
-            .collect();
+        let present = names.iter().any(|name| args.output.join(name).exists());
         let intact = names.iter().all(|name| {
             let path = args.output.join(name);
             path.exists() && manifest::verified(&path, digests.get(name))
@@ -535,7 +533,7 @@ fn frames_to_render(args: &VideoArgs, range: std::ops::Range<usize>) -> Vec<usiz
         if intact {
             continue;
         }
-        if !present.is_empty() {
+        if present {
             rejected += 1;
         }
         todo.push(i);

@@ -25,15 +25,10 @@ use crate::render::timeline::{planning_frames, Timeline};
 use crate::render::Rasterizer;
 use crate::{Error, Result};
 
-/// Whether the options ask for two eyes.
-pub(super) fn asked(args: &VideoArgs) -> bool {
-    args.pair.asked()
-}
-
 /// Refuses the pair's options without a pair, and what a pair cannot take.
 pub(super) fn check(args: &VideoArgs) -> Result<()> {
     args.pair.check(&[("--stereo", args.stereo.is_some())])?;
-    if !asked(args) {
+    if !args.pair.asked() {
         return Ok(());
     }
     if args.side_by_side.is_some() {
@@ -74,7 +69,7 @@ pub(super) fn stereo_name(args: &VideoArgs) -> &'static str {
 /// The files of frame `index`: one, or for `separate` the left eye's and the right's.
 pub(super) fn frame_names(args: &VideoArgs, index: usize) -> Vec<String> {
     let name = super::video::frame_name(index, args.format);
-    if !asked(args) || stereo(args) != StereoOutput::Separate {
+    if !args.pair.asked() || stereo(args) != StereoOutput::Separate {
         return vec![name];
     }
     let (stem, ext) = name
@@ -229,7 +224,7 @@ pub(super) fn plan(
 /// The pair while it renders: each eye's renderer, and those of an eye limited beyond
 /// infinity (made when a frame first needs one).
 pub(super) struct PairExport {
-    pub setup: PairSetup,
+    setup: PairSetup,
     needs: [SceneNeeds; 2],
     options: KernelOptions,
     splat: SplatSettings,
